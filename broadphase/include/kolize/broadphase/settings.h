@@ -1,0 +1,54 @@
+#pragma once
+/// \file
+/// Settings shared by every broadphase the factory makes, with documented defaults.
+
+#include <LinearMath/btVector3.h>
+
+#include <functional>
+#include <string>
+
+class btOverlappingPairCache;
+
+namespace kolize {
+
+/// What a kolize broadphase tells you when it rejects an AABB.
+struct BadAabbReport {
+    /// Name of the broadphase ("grid", "brute-force", ...).
+    std::string broadphase;
+    /// "createProxy" or "setAabb".
+    std::string operation;
+    /// The proxy's m_uniqueId and m_clientObject (Bullet's btCollisionObject*, usually).
+    int proxyUid = 0;
+    const void* clientObject = nullptr;
+    /// The rejected box, as given.
+    btVector3 aabbMin;
+    btVector3 aabbMax;
+    /// Why it was rejected: "NaN coordinate", "infinite coordinate", "min > max".
+    std::string reason;
+    /// One line naming the broadphase, the proxy, the values and the reason.
+    std::string message() const;
+};
+
+/// Settings for kolize::makeBroadphase. Every field has a usable default.
+struct BroadphaseSettings {
+    /// World bounds for Bullet's sweep-and-prune ("sap", "sap-noray", "sap32"). SAP quantises
+    /// boxes to this region; objects outside it still get (conservative) pairs. kolize's
+    /// own broadphases are unbounded and ignore these.
+    btVector3 worldMin{-1000, -1000, -1000};
+    btVector3 worldMax{1000, 1000, 1000};
+    /// Capacity of the fixed-size Bullet broadphases: "sap" and "sap-noray" (at most 32766,
+    /// a limit of btAxisSweep3's 16-bit handles), "sap32" and "simple". Creating more
+    /// proxies than this fails inside Bullet. kolize's broadphases and "dbvt" grow freely.
+    int maxProxies = 32766;
+    /// Pair cache to use instead of a new btHashedOverlappingPairCache. Not owned: it must
+    /// outlive the broadphase. kolize's broadphases need immediate removal and reject a
+    /// cache with deferred removal (btSortedOverlappingPairCache) with std::invalid_argument.
+    btOverlappingPairCache* pairCache = nullptr;
+    /// Called when a kolize broadphase rejects an AABB (NaN, +-inf, or min > max). The proxy
+    /// keeps its last valid box; a proxy created with a bad box takes part in no pair until
+    /// its first valid setAabb. Empty (the default): print the report's message() on stderr,
+    /// the first 16 times per broadphase, then count silently (see printStats()).
+    std::function<void(const BadAabbReport&)> onBadAabb;
+};
+
+}  // namespace kolize

@@ -1,0 +1,42 @@
+#pragma once
+/// \file
+/// kolize: drop-in replacements for Bullet's broadphase.
+///
+///     #include <kolize/kolize.h>
+///     auto broadphase = kolize::makeBroadphase("brute-force");
+///     btDiscreteDynamicsWorld world(dispatcher, broadphase.get(), solver, configuration);
+///
+/// Bullet's own broadphases are available under the same factory for comparison.
+
+#include <kolize/broadphase/settings.h>
+
+#include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace kolize {
+
+/// Makes the broadphase called `name`. Names (see broadphaseNames()):
+/// - "brute-force": kolize's exact reference (tests every pair; O(N^2) per frame).
+/// - "dbvt": Bullet's btDbvtBroadphase.
+/// - "sap": Bullet's btAxisSweep3 over settings.worldMin/worldMax, with its ray accelerator.
+/// - "sap-noray": the same without the ray accelerator.
+/// - "sap32": Bullet's bt32BitAxisSweep3.
+/// - "simple": Bullet's btSimpleBroadphase.
+/// kolize's broadphases report exactly the pairs whose AABBs overlap (closed intervals)
+/// and pass the pair cache's filters; Bullet's report supersets.
+/// Throws std::invalid_argument for an unknown name (the message lists the valid ones)
+/// or for invalid settings.
+std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
+                                                      const BroadphaseSettings& settings = {});
+
+/// All names makeBroadphase accepts, kolize's first.
+const std::vector<std::string>& broadphaseNames();
+
+/// True for the names whose pair output is exact (kolize's own broadphases).
+bool isExactBroadphase(std::string_view name);
+
+}  // namespace kolize

@@ -1,0 +1,76 @@
+#include <kolize/kolize.h>
+
+#include <kolize/broadphase/brute_force.h>
+#include <kolize/broadphase/bullet_adapter.h>
+
+#include <BulletCollision/BroadphaseCollision/btAxisSweep3.h>
+#include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
+#include <BulletCollision/BroadphaseCollision/btSimpleBroadphase.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace kolize {
+
+namespace {
+
+constexpr int kSap16MaxProxies = 32766;
+
+std::string nameList() {
+    std::string out;
+    for (const std::string& name : broadphaseNames()) {
+        out += (out.empty() ? "" : ", ") + name;
+    }
+    return out;
+}
+
+void requireCapacity(std::string_view name, int maxProxies, int limit) {
+    if (maxProxies < 2 || maxProxies > limit) {
+        throw std::invalid_argument("kolize: broadphase '" + std::string(name) +
+                                    "' needs settings.maxProxies in [2, " + std::to_string(limit) +
+                                    "], got " + std::to_string(maxProxies));
+    }
+}
+
+}  // namespace
+
+const std::vector<std::string>& broadphaseNames() {
+    static const std::vector<std::string> names = {"brute-force", "dbvt",  "sap",
+                                                   "sap-noray",   "sap32", "simple"};
+    return names;
+}
+
+bool isExactBroadphase(std::string_view name) {
+    return name == "brute-force";
+}
+
+std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
+                                                      const BroadphaseSettings& settings) {
+    if (name == "brute-force") {
+        return std::make_unique<CoreBroadphase<BruteForce<3, btScalar>>>(std::string(name),
+                                                                         settings);
+    }
+    if (name == "dbvt") {
+        return std::make_unique<btDbvtBroadphase>(settings.pairCache);
+    }
+    if (name == "sap" || name == "sap-noray") {
+        requireCapacity(name, settings.maxProxies, kSap16MaxProxies);
+        return std::make_unique<btAxisSweep3>(
+            settings.worldMin, settings.worldMax, static_cast<unsigned short>(settings.maxProxies),
+            settings.pairCache, /*disableRaycastAccelerator=*/name == "sap-noray");
+    }
+    if (name == "sap32") {
+        requireCapacity(name, settings.maxProxies, 0x7ffffffe);
+        return std::make_unique<bt32BitAxisSweep3>(settings.worldMin, settings.worldMax,
+                                                   static_cast<unsigned>(settings.maxProxies),
+                                                   settings.pairCache);
+    }
+    if (name == "simple") {
+        requireCapacity(name, settings.maxProxies, 0x7ffffffe);
+        return std::make_unique<btSimpleBroadphase>(settings.maxProxies, settings.pairCache);
+    }
+    throw std::invalid_argument("kolize: unknown broadphase '" + std::string(name) +
+                                "'; valid names: " + nameList());
+}
+
+}  // namespace kolize

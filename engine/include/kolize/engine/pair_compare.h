@@ -1,0 +1,45 @@
+#pragma once
+/// \file
+/// Exact truth for a set of Bullet proxies, and comparison of a pair cache against it.
+/// Shared by the conformance tests, the pair-stream replay and the demos.
+
+#include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
+#include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace kolize {
+
+/// An unordered pair of proxies by m_uniqueId, smaller first.
+using UidPair = std::pair<int, int>;
+
+inline UidPair uidPair(const btBroadphaseProxy* a, const btBroadphaseProxy* b) {
+    return a->m_uniqueId < b->m_uniqueId ? UidPair{a->m_uniqueId, b->m_uniqueId}
+                                         : UidPair{b->m_uniqueId, a->m_uniqueId};
+}
+
+/// The pairs whose boxes (proxy->m_aabbMin/m_aabbMax) overlap as closed intervals, tested
+/// with Bullet's own TestAabbAgainstAabb2, and that pass `filter`'s needsBroadphaseCollision
+/// (skipped when filter is null). Sorted. Sweep on x, so O(N log N + pairs on x).
+std::vector<UidPair> exactPairs(const std::vector<const btBroadphaseProxy*>& proxies,
+                                const btOverlappingPairCache* filter);
+
+/// The same by testing every pair: O(N^2). The reference for exactPairs itself.
+std::vector<UidPair> exactPairsNaive(const std::vector<const btBroadphaseProxy*>& proxies,
+                                     const btOverlappingPairCache* filter);
+
+/// The pairs held by the cache, sorted.
+std::vector<UidPair> cachedPairs(const btOverlappingPairCache& cache);
+
+/// Difference between reported and true pairs (both sorted).
+struct PairDifference {
+    std::vector<UidPair> missing;  ///< in truth, not reported: false negatives
+    std::vector<UidPair> extra;    ///< reported, not in truth: false positives
+    bool exact() const { return missing.empty() && extra.empty(); }
+};
+PairDifference comparePairs(const std::vector<UidPair>& truth,
+                            const std::vector<UidPair>& reported);
+
+}  // namespace kolize
