@@ -83,11 +83,16 @@ void FallingBoxesWorld::step() {
     world_->stepSimulation(btScalar(settings_.timeStep), 0);
 }
 
-std::vector<const btBroadphaseProxy*> FallingBoxesWorld::proxies() const {
-    std::vector<const btBroadphaseProxy*> out;
+std::vector<ProxyBox> FallingBoxesWorld::proxyBoxes() const {
+    // Every step's updateAabbs calls setAabb for every object (m_forceUpdateAllAabbs is
+    // on by default), so the broadphase's stored box is the one the world gave it.
+    std::vector<ProxyBox> out;
     const btCollisionObjectArray& objects = world_->getCollisionObjectArray();
     for (int i = 0; i < objects.size(); ++i) {
-        out.push_back(objects[i]->getBroadphaseHandle());
+        ProxyBox box;
+        box.proxy = objects[i]->getBroadphaseHandle();
+        broadphase_->getAabb(objects[i]->getBroadphaseHandle(), box.aabbMin, box.aabbMax);
+        out.push_back(box);
     }
     return out;
 }

@@ -14,28 +14,30 @@ bool wanted(const btOverlappingPairCache* filter, const btBroadphaseProxy* a,
                                                                  const_cast<btBroadphaseProxy*>(b));
 }
 
-bool boxesOverlap(const btBroadphaseProxy* a, const btBroadphaseProxy* b) {
-    return TestAabbAgainstAabb2(a->m_aabbMin, a->m_aabbMax, b->m_aabbMin, b->m_aabbMax);
+bool boxesOverlap(const ProxyBox& a, const ProxyBox& b) {
+    return TestAabbAgainstAabb2(a.aabbMin, a.aabbMax, b.aabbMin, b.aabbMax);
 }
 
 }  // namespace
 
-std::vector<UidPair> exactPairs(const std::vector<const btBroadphaseProxy*>& proxies,
+std::vector<UidPair> exactPairs(const std::vector<ProxyBox>& boxes,
                                 const btOverlappingPairCache* filter) {
-    std::vector<const btBroadphaseProxy*> byMinX(proxies);
+    std::vector<const ProxyBox*> byMinX;
+    byMinX.reserve(boxes.size());
+    for (const ProxyBox& box : boxes) {
+        byMinX.push_back(&box);
+    }
     std::sort(byMinX.begin(), byMinX.end(),
-              [](const btBroadphaseProxy* a, const btBroadphaseProxy* b) {
-                  return a->m_aabbMin.x() < b->m_aabbMin.x();
-              });
+              [](const ProxyBox* a, const ProxyBox* b) { return a->aabbMin.x() < b->aabbMin.x(); });
     std::vector<UidPair> out;
     for (std::size_t i = 0; i < byMinX.size(); ++i) {
-        const btBroadphaseProxy* a = byMinX[i];
-        // Sorted by min x: every later box starting at or before a's max x may overlap.
-        for (std::size_t j = i + 1;
-             j < byMinX.size() && byMinX[j]->m_aabbMin.x() <= a->m_aabbMax.x(); ++j) {
-            const btBroadphaseProxy* b = byMinX[j];
-            if (boxesOverlap(a, b) && wanted(filter, a, b)) {
-                out.push_back(uidPair(a, b));
+        const ProxyBox& a = *byMinX[i];
+        // Sorted by min x: only later boxes starting at or before a's max x can overlap a.
+        for (std::size_t j = i + 1; j < byMinX.size() && byMinX[j]->aabbMin.x() <= a.aabbMax.x();
+             ++j) {
+            const ProxyBox& b = *byMinX[j];
+            if (boxesOverlap(a, b) && wanted(filter, a.proxy, b.proxy)) {
+                out.push_back(uidPair(a.proxy, b.proxy));
             }
         }
     }
@@ -43,13 +45,14 @@ std::vector<UidPair> exactPairs(const std::vector<const btBroadphaseProxy*>& pro
     return out;
 }
 
-std::vector<UidPair> exactPairsNaive(const std::vector<const btBroadphaseProxy*>& proxies,
+std::vector<UidPair> exactPairsNaive(const std::vector<ProxyBox>& boxes,
                                      const btOverlappingPairCache* filter) {
     std::vector<UidPair> out;
-    for (std::size_t i = 0; i < proxies.size(); ++i) {
-        for (std::size_t j = i + 1; j < proxies.size(); ++j) {
-            if (boxesOverlap(proxies[i], proxies[j]) && wanted(filter, proxies[i], proxies[j])) {
-                out.push_back(uidPair(proxies[i], proxies[j]));
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+            if (boxesOverlap(boxes[i], boxes[j]) &&
+                wanted(filter, boxes[i].proxy, boxes[j].proxy)) {
+                out.push_back(uidPair(boxes[i].proxy, boxes[j].proxy));
             }
         }
     }

@@ -263,6 +263,7 @@ ReplayResult replay(const PairStream& stream, std::string_view name,
     ReplayResult result;
     result.broadphase = std::string(name);
     std::vector<btBroadphaseProxy*> proxies;
+    std::vector<ProxyBox> boxes;
     auto toVector = [](const double* v) {
         return btVector3(btScalar(v[0]), btScalar(v[1]), btScalar(v[2]));
     };
@@ -271,9 +272,12 @@ ReplayResult replay(const PairStream& stream, std::string_view name,
     for (const StreamEvent& event : stream.events) {
         switch (event.op) {
             case StreamEvent::Op::Create:
+                // Bullet's broadphases ignore proxies without a client object; any address will do.
                 proxies.push_back(broadphase->createProxy(toVector(event.aabbMin),
-                                                          toVector(event.aabbMax), 0, nullptr,
+                                                          toVector(event.aabbMax), 0, &proxies,
                                                           event.group, event.mask, nullptr));
+                boxes.push_back(
+                    ProxyBox{proxies.back(), toVector(event.aabbMin), toVector(event.aabbMax)});
                 break;
             case StreamEvent::Op::Destroy:
                 broadphase->destroyProxy(proxies[event.object], nullptr);
@@ -282,6 +286,8 @@ ReplayResult replay(const PairStream& stream, std::string_view name,
             case StreamEvent::Op::SetAabb:
                 broadphase->setAabb(proxies[event.object], toVector(event.aabbMin),
                                     toVector(event.aabbMax), nullptr);
+                boxes[event.object].aabbMin = toVector(event.aabbMin);
+                boxes[event.object].aabbMax = toVector(event.aabbMax);
                 break;
             case StreamEvent::Op::EndFrame: {
                 frame.updateSeconds = secondsSince(start);
@@ -289,10 +295,10 @@ ReplayResult replay(const PairStream& stream, std::string_view name,
                 broadphase->calculateOverlappingPairs(nullptr);
                 frame.pairSeconds = secondsSince(pairStart);
 
-                std::vector<const btBroadphaseProxy*> live;
-                for (const btBroadphaseProxy* proxy : proxies) {
-                    if (proxy != nullptr) {
-                        live.push_back(proxy);
+                std::vector<ProxyBox> live;
+                for (std::size_t object = 0; object < proxies.size(); ++object) {
+                    if (proxies[object] != nullptr) {
+                        live.push_back(boxes[object]);
                     }
                 }
                 const btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();

@@ -4,6 +4,8 @@
 /// layers of 8 x 8 falling onto a static ground box or plane), as a real
 /// btDiscreteDynamicsWorld over any broadphase. Shared by tests and demos.
 
+#include <kolize/engine/pair_compare.h>
+
 #include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 
@@ -57,8 +59,8 @@ class FallingBoxesWorld {
     btBroadphaseInterface& broadphase() { return *broadphase_; }
     btCollisionDispatcher& dispatcher() { return *dispatcher_; }
     const std::vector<btRigidBody*>& bodies() const { return bodies_; }
-    /// The broadphase proxies of every collision object in the world.
-    std::vector<const btBroadphaseProxy*> proxies() const;
+    /// The broadphase proxy of every collision object with the box the world last gave it.
+    std::vector<ProxyBox> proxyBoxes() const;
     /// Removes one body from the world and deletes it.
     void removeBody(btRigidBody* body);
 

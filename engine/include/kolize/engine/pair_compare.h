@@ -20,14 +20,22 @@ inline UidPair uidPair(const btBroadphaseProxy* a, const btBroadphaseProxy* b) {
                                          : UidPair{b->m_uniqueId, a->m_uniqueId};
 }
 
-/// The pairs whose boxes (proxy->m_aabbMin/m_aabbMax) overlap as closed intervals, tested
-/// with Bullet's own TestAabbAgainstAabb2, and that pass `filter`'s needsBroadphaseCollision
-/// (skipped when filter is null). Sorted. Sweep on x, so O(N log N + pairs on x).
-std::vector<UidPair> exactPairs(const std::vector<const btBroadphaseProxy*>& proxies,
+/// A proxy with the box it should have: what the caller last gave the broadphase. (Not read
+/// from the proxy: btAxisSweep3 leaves m_aabbMin/m_aabbMax unset until the first setAabb.)
+struct ProxyBox {
+    const btBroadphaseProxy* proxy = nullptr;
+    btVector3 aabbMin;
+    btVector3 aabbMax;
+};
+
+/// The pairs whose boxes overlap as closed intervals, tested with Bullet's own
+/// TestAabbAgainstAabb2, and that pass `filter`'s needsBroadphaseCollision (skipped when
+/// filter is null). Sorted. Sweep on x, so O(N log N + pairs overlapping on x).
+std::vector<UidPair> exactPairs(const std::vector<ProxyBox>& boxes,
                                 const btOverlappingPairCache* filter);
 
 /// The same by testing every pair: O(N^2). The reference for exactPairs itself.
-std::vector<UidPair> exactPairsNaive(const std::vector<const btBroadphaseProxy*>& proxies,
+std::vector<UidPair> exactPairsNaive(const std::vector<ProxyBox>& boxes,
                                      const btOverlappingPairCache* filter);
 
 /// The pairs held by the cache, sorted.
