@@ -1,0 +1,319 @@
+// kolize's own guarantees beyond the conformance kit: the bad-AABB policy, filters that
+// change, the factory's errors, the pair set, the oracle itself, and pair streams.
+
+#include <kolize/broadphase/bullet_adapter.h>
+#include <kolize/broadphase/pair_set.h>
+#include <kolize/engine/falling_boxes.h>
+#include <kolize/engine/pair_compare.h>
+#include <kolize/engine/pair_stream.h>
+#include <kolize/kolize.h>
+
+#include <btBulletDynamicsCommon.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <random>
+
+namespace kolize {
+namespace {
+
+struct Reports {
+    std::vector<BadAabbReport> seen;
+    BroadphaseSettings settings() {
+        BroadphaseSettings out;
+        out.onBadAabb = [this](const BadAabbReport& report) { seen.push_back(report); };
+        return out;
+    }
+};
+
+int pairCount(btBroadphaseInterface& broadphase) {
+    broadphase.calculateOverlappingPairs(nullptr);
+    return broadphase.getOverlappingPairCache()->getNumOverlappingPairs();
+}
+
+TEST(BadAabbPolicy, NanSetAabbIsReportedAndTheLastValidBoxKept) {
+    Reports reports;
+    auto broadphase = makeBroadphase("brute-force", reports.settings());
+    char clients[2];
+    btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
+                                                   &clients[0], 1, -1, nullptr);
+    broadphase->createProxy(btVector3(0.5, 0.5, 0.5), btVector3(2, 2, 2), 0, &clients[1], 1, -1,
+                            nullptr);
+    ASSERT_EQ(pairCount(*broadphase), 1);
+
+    const btScalar nan = std::numeric_limits<btScalar>::quiet_NaN();
+    broadphase->setAabb(a, btVector3(nan, 0, 0), btVector3(1, 1, 1), nullptr);
+    ASSERT_EQ(reports.seen.size(), 1u);
+    EXPECT_EQ(reports.seen[0].operation, "setAabb");
+    EXPECT_EQ(reports.seen[0].proxyUid, a->m_uniqueId);
+    EXPECT_EQ(reports.seen[0].clientObject, &clients[0]);
+    const std::string message = reports.seen[0].message();
+    EXPECT_NE(message.find("NaN"), std::string::npos) << message;
+    EXPECT_NE(message.find("uid " + std::to_string(a->m_uniqueId)), std::string::npos) << message;
+    EXPECT_NE(message.find("brute-force"), std::string::npos) << message;
+
+    btVector3 lo, hi;
+    broadphase->getAabb(a, lo, hi);
+    EXPECT_EQ(lo, btVector3(0, 0, 0));
+    EXPECT_EQ(hi, btVector3(1, 1, 1));
+    EXPECT_EQ(pairCount(*broadphase), 1) << "the proxy keeps its pair with its last valid box";
+    dynamic_cast<BroadphaseAdapter&>(*broadphase).validate();
+}
+
+TEST(BadAabbPolicy, InvertedAndInfiniteBoxesAreRejectedButPlanesAccepted) {
+    Reports reports;
+    auto broadphase = makeBroadphase("brute-force", reports.settings());
+    char clients[2];
+    btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
+                                                   &clients[0], 1, -1, nullptr);
+    const btScalar inf = std::numeric_limits<btScalar>::infinity();
+    broadphase->setAabb(a, btVector3(2, 0, 0), btVector3(1, 1, 1), nullptr);
+    broadphase->setAabb(a, btVector3(-inf, 0, 0), btVector3(1, 1, 1), nullptr);
+    ASSERT_EQ(reports.seen.size(), 2u);
+    EXPECT_EQ(reports.seen[0].reason, "min > max");
+    EXPECT_NE(reports.seen[1].reason.find("infinite"), std::string::npos);
+
+    // +-1e18, as btStaticPlaneShape reports, is a legal box.
+    broadphase->createProxy(btVector3(-1e18, -1e18, -1e18), btVector3(1e18, 1e18, 1e18), 0,
+                            &clients[1], 1, -1, nullptr);
+    EXPECT_EQ(reports.seen.size(), 2u);
+    EXPECT_EQ(pairCount(*broadphase), 1);
+    EXPECT_EQ(dynamic_cast<BroadphaseAdapter&>(*broadphase).stats().badAabbReports, 2u);
+}
+
+TEST(BadAabbPolicy, ProxyCreatedWithABadBoxWaitsForAValidOne) {
+    Reports reports;
+    auto broadphase = makeBroadphase("brute-force", reports.settings());
+    char clients[2];
+    broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[0], 1, -1, nullptr);
+    const btScalar nan = std::numeric_limits<btScalar>::quiet_NaN();
+    btBroadphaseProxy* parked = broadphase->createProxy(
+        btVector3(nan, nan, nan), btVector3(1, 1, 1), 0, &clients[1], 1, -1, nullptr);
+    ASSERT_NE(parked, nullptr) << "never dropped";
+    ASSERT_EQ(reports.seen.size(), 1u);
+    EXPECT_EQ(reports.seen[0].operation, "createProxy");
+    auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+    EXPECT_EQ(adapter.stats().parkedProxies, 1u);
+    EXPECT_EQ(pairCount(*broadphase), 0);
+    adapter.validate();
+
+    broadphase->setAabb(parked, btVector3(0.5, 0.5, 0.5), btVector3(1, 1, 1), nullptr);
+    EXPECT_EQ(pairCount(*broadphase), 1);
+    EXPECT_EQ(adapter.stats().parkedProxies, 0u);
+    adapter.validate();
+    broadphase->destroyProxy(parked, nullptr);
+    EXPECT_EQ(broadphase->getOverlappingPairCache()->getNumOverlappingPairs(), 0);
+}
+
+TEST(BadAabbPolicy, ForeignOrDestroyedProxyIsAClearError) {
+    auto broadphase = makeBroadphase("brute-force");
+    char client;
+    btBroadphaseProxy* a =
+        broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &client, 1, -1, nullptr);
+    broadphase->destroyProxy(a, nullptr);
+    EXPECT_THROW(broadphase->destroyProxy(a, nullptr), std::invalid_argument);
+}
+
+TEST(Filters, ChangedGroupsAndMasksTakeEffectOnTheNextFrame) {
+    auto broadphase = makeBroadphase("brute-force");
+    char clients[2];
+    btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
+                                                   &clients[0], 1, -1, nullptr);
+    broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[1], 2, -1, nullptr);
+    EXPECT_EQ(pairCount(*broadphase), 1);
+    a->m_collisionFilterMask = 1;  // no longer accepts group 2
+    EXPECT_EQ(pairCount(*broadphase), 0);
+    a->m_collisionFilterMask = -1;
+    EXPECT_EQ(pairCount(*broadphase), 1);
+}
+
+TEST(Factory, UnknownNameListsTheValidOnes) {
+    try {
+        makeBroadphase("octree");
+        FAIL() << "no exception";
+    } catch (const std::invalid_argument& error) {
+        const std::string message = error.what();
+        EXPECT_NE(message.find("octree"), std::string::npos);
+        for (const std::string& name : broadphaseNames()) {
+            EXPECT_NE(message.find(name), std::string::npos) << name;
+        }
+    }
+}
+
+TEST(Factory, MakesEveryNameAndRejectsBadSettings) {
+    for (const std::string& name : broadphaseNames()) {
+        EXPECT_NE(makeBroadphase(name), nullptr) << name;
+    }
+    BroadphaseSettings tooMany;
+    tooMany.maxProxies = 40000;
+    EXPECT_THROW(makeBroadphase("sap", tooMany), std::invalid_argument);
+    btSortedOverlappingPairCache deferred;
+    BroadphaseSettings withDeferred;
+    withDeferred.pairCache = &deferred;
+    EXPECT_THROW(makeBroadphase("brute-force", withDeferred), std::invalid_argument);
+    EXPECT_TRUE(isExactBroadphase("brute-force"));
+    EXPECT_FALSE(isExactBroadphase("dbvt"));
+}
+
+TEST(Factory, UsesAGivenPairCacheWithoutOwningIt) {
+    btHashedOverlappingPairCache cache;
+    BroadphaseSettings settings;
+    settings.pairCache = &cache;
+    {
+        auto broadphase = makeBroadphase("brute-force", settings);
+        EXPECT_EQ(broadphase->getOverlappingPairCache(), &cache);
+        char clients[2];
+        broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[0], 1, -1,
+                                nullptr);
+        broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[1], 1, -1,
+                                nullptr);
+        EXPECT_EQ(pairCount(*broadphase), 1);
+        EXPECT_EQ(cache.getNumOverlappingPairs(), 1);
+    }
+}
+
+TEST(PairSet, MatchesAStdMapUnderRandomInsertsAndSweeps) {
+    std::mt19937 random(7);
+    PairSet set;
+    std::map<std::uint64_t, std::uint32_t> reference;
+    std::size_t erased = 0;
+    for (std::uint32_t stamp = 1; stamp <= 200; ++stamp) {
+        for (int i = 0; i < 300; ++i) {
+            const ObjectId a = random() % 400, b = random() % 400;
+            if (a == b) {
+                continue;
+            }
+            bool inserted = false;
+            set.findOrInsert(a, b, inserted).stamp = stamp;
+            const bool referenceInserted = reference.count(PairSet::keyOf(a, b)) == 0;
+            ASSERT_EQ(inserted, referenceInserted);
+            reference[PairSet::keyOf(a, b)] = stamp;
+        }
+        // Keep what was touched in the last three rounds.
+        set.retainIf([&](PairSet::Entry& entry) { return entry.stamp + 3 > stamp; });
+        for (auto it = reference.begin(); it != reference.end();) {
+            if (it->second + 3 > stamp) {
+                ++it;
+            } else {
+                it = reference.erase(it);
+                ++erased;
+            }
+        }
+        ASSERT_EQ(set.size(), reference.size());
+        ASSERT_NO_THROW(set.validate());
+    }
+    std::size_t visited = 0;
+    set.forEach([&](const PairSet::Entry& entry) {
+        ++visited;
+        EXPECT_EQ(reference.count(entry.key), 1u);
+    });
+    EXPECT_EQ(visited, reference.size());
+    EXPECT_GT(erased, 10000u) << "the sweep must have removed many entries";
+}
+
+TEST(Oracle, SweepMatchesTheNaiveDoubleLoop) {
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> coordinate(-10, 10), size(0, 3);
+    std::vector<btBroadphaseProxy> proxies(500);
+    std::vector<ProxyBox> boxes;
+    for (std::size_t i = 0; i < proxies.size(); ++i) {
+        proxies[i].m_uniqueId = static_cast<int>(i);
+        const btVector3 lo(btScalar(coordinate(random)), btScalar(coordinate(random)),
+                           btScalar(coordinate(random)));
+        btVector3 hi =
+            lo + btVector3(btScalar(size(random)), btScalar(size(random)), btScalar(size(random)));
+        if (i % 50 == 0) {
+            hi = lo;  // zero extent
+        }
+        boxes.push_back(ProxyBox{&proxies[i], lo, hi});
+    }
+    boxes[1].aabbMin = btVector3(-1e18, -1e18, -1e18);
+    boxes[1].aabbMax = btVector3(1e18, 1e18, 1e18);
+    // A touching pair: shares exactly one face.
+    boxes[2].aabbMin = boxes[3].aabbMax;
+    boxes[2].aabbMax = boxes[3].aabbMax + btVector3(1, 1, 1);
+    const std::vector<UidPair> sweep = exactPairs(boxes, nullptr);
+    EXPECT_EQ(sweep, exactPairsNaive(boxes, nullptr));
+    const auto withPlane = std::count_if(sweep.begin(), sweep.end(), [](const UidPair& pair) {
+        return pair.first == 1 || pair.second == 1;
+    });
+    EXPECT_EQ(withPlane, 499) << "the plane overlaps every box";
+    EXPECT_GT(sweep.size() - withPlane, 500u) << "the sample must hold many ordinary pairs";
+    EXPECT_TRUE(std::binary_search(sweep.begin(), sweep.end(), UidPair{2, 3}));
+}
+
+TEST(PairStream, RecordsAWorldAndReplaysExactlyIntoEveryBroadphase) {
+    PairStream stream;
+    FallingBoxesSettings settings;
+    settings.layers = 3;
+    settings.boxesPerRow = 4;
+    {
+        auto inner = makeBroadphase("brute-force");
+        auto* recorder = new RecordingBroadphase(*inner, stream);
+        FallingBoxesWorld world(std::unique_ptr<btBroadphaseInterface>(recorder), settings);
+        for (int step = 0; step < 60; ++step) {
+            world.step();
+        }
+        world.removeBody(world.bodies().back());
+        world.step();
+    }
+    ASSERT_EQ(stream.frames(), 61u);
+
+    const std::string path = ::testing::TempDir() + "kolize_stream_test.bin";
+    stream.save(path);
+    const PairStream loaded = PairStream::load(path);
+    ASSERT_EQ(loaded.events.size(), stream.events.size());
+    for (std::size_t i = 0; i < stream.events.size(); ++i) {
+        ASSERT_EQ(loaded.events[i].op, stream.events[i].op) << i;
+        ASSERT_EQ(loaded.events[i].object, stream.events[i].object) << i;
+        ASSERT_EQ(loaded.events[i].aabbMax[1], stream.events[i].aabbMax[1]) << i;
+    }
+
+    for (const std::string& name : broadphaseNames()) {
+        const ReplayResult result = replay(loaded, name);
+        ASSERT_EQ(result.frames.size(), 61u);
+        EXPECT_EQ(result.totalMissing(), 0u) << name;
+        if (isExactBroadphase(name)) {
+            EXPECT_EQ(result.totalExtra(), 0u) << name;
+        }
+        EXPECT_GT(result.frames.back().truePairs, 20u) << "the boxes rest on each other";
+    }
+    std::remove(path.c_str());
+}
+
+TEST(PairStream, UnreadableFilesGiveErrorsNamingTheFileAndTheProblem) {
+    const auto expectError = [](const std::string& path, const std::string& fragment) {
+        try {
+            PairStream::load(path);
+            ADD_FAILURE() << "no exception for " << path;
+        } catch (const std::runtime_error& error) {
+            const std::string message = error.what();
+            EXPECT_NE(message.find(path), std::string::npos) << message;
+            EXPECT_NE(message.find(fragment), std::string::npos) << message;
+        }
+    };
+    expectError("/nonexistent/stream.bin", "cannot open");
+    const std::string path = ::testing::TempDir() + "kolize_bad_stream.bin";
+    std::ofstream(path) << "not a stream at all";
+    expectError(path, "bad magic");
+    {
+        PairStream stream;
+        StreamEvent create;
+        create.op = StreamEvent::Op::Create;
+        stream.events.push_back(create);
+        stream.save(path);
+        std::ifstream in(path, std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::ofstream(path, std::ios::binary) << bytes.substr(0, bytes.size() - 3);
+    }
+    expectError(path, "truncated");
+    std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace kolize
