@@ -192,11 +192,11 @@ class RandomScene {
 
     void destroy(std::size_t index) {
         const Object object = objects_[index];
+        const int uid = object.proxy->m_uniqueId;  // the proxy's memory may be freed below
         broadphase_->destroyProxy(object.proxy, nullptr);
         // destroyProxy must take the proxy's pairs out of the cache at once.
         for (const UidPair& pair : cachedPairs(*cache_)) {
-            ASSERT_TRUE(pair.first != object.proxy->m_uniqueId &&
-                        pair.second != object.proxy->m_uniqueId)
+            ASSERT_TRUE(pair.first != uid && pair.second != uid)
                 << name_ << ": pair of a destroyed proxy left in the cache";
         }
         if (object.aabbMax.x() >= kPlane) {
