@@ -115,6 +115,13 @@ class RandomScene {
         adapter_ = dynamic_cast<BroadphaseAdapter*>(broadphase_.get());
     }
 
+    ~RandomScene() {
+        // As a world does before deleting its broadphase (dbvt frees proxies only here).
+        for (const Object& object : objects_) {
+            broadphase_->destroyProxy(object.proxy, nullptr);
+        }
+    }
+
     void run(int frames, int initialObjects) {
         for (int i = 0; i < initialObjects; ++i) {
             create();
