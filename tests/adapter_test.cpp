@@ -119,6 +119,29 @@ TEST(BadAabbPolicy, ForeignOrDestroyedProxyIsAClearError) {
     EXPECT_THROW(broadphase->destroyProxy(a, nullptr), std::invalid_argument);
 }
 
+TEST(ProxyLifetime, ChurnWithoutPairFindingReleasesSlotsAndKeepsPairsRight) {
+    // Regression guard: destroyed slots wait for the next frame before reuse; an app that
+    // never computes pairs must still get them back (and no stale pair may survive).
+    auto broadphase = makeBroadphase("brute-force");
+    auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+    char clients[3];
+    broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[0], 1, -1, nullptr);
+    btBroadphaseProxy* churn = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
+                                                       &clients[1], 1, -1, nullptr);
+    ASSERT_EQ(pairCount(*broadphase), 1);
+    for (int i = 0; i < 10000; ++i) {
+        broadphase->destroyProxy(churn, nullptr);
+        churn = broadphase->createProxy(btVector3(5, 5, 5), btVector3(6, 6, 6), 0, &clients[2], 1,
+                                        -1, nullptr);
+    }
+    adapter.validate();
+    EXPECT_LT(adapter.stats().memoryBytes, 1u << 20) << "slots were not released";
+    EXPECT_EQ(pairCount(*broadphase), 0);
+    broadphase->setAabb(churn, btVector3(0.5, 0.5, 0.5), btVector3(2, 2, 2), nullptr);
+    EXPECT_EQ(pairCount(*broadphase), 1);
+    adapter.validate();
+}
+
 TEST(Filters, ChangedGroupsAndMasksTakeEffectOnTheNextFrame) {
     auto broadphase = makeBroadphase("brute-force");
     char clients[2];

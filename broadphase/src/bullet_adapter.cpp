@@ -12,6 +12,7 @@ namespace kolize {
 namespace {
 
 constexpr std::size_t kDefaultReportsPrinted = 16;
+constexpr std::size_t kMaxPendingFree = 4096;
 
 void appendVector(std::ostringstream& out, const btVector3& v) {
     out << '(' << v.x() << ", " << v.y() << ", " << v.z() << ')';
@@ -168,6 +169,23 @@ void BroadphaseAdapter::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dis
     pendingFree_.push_back(slot);
     ours->m_clientObject = nullptr;
     --liveCount_;
+    if (pendingFree_.size() > kMaxPendingFree) {
+        // An app that creates and destroys without ever computing pairs must not grow
+        // without bound: drop the destroyed slots' pairs now and release the slots.
+        pairs_.retainIf([&](const PairSet::Entry& entry) {
+            return state_[entry.first()] != SlotState::PendingFree &&
+                   state_[entry.second()] != SlotState::PendingFree;
+        });
+        releasePendingSlots();
+    }
+}
+
+void BroadphaseAdapter::releasePendingSlots() {
+    for (ObjectId slot : pendingFree_) {
+        state_[slot] = SlotState::Free;
+        freeSlots_.push_back(slot);
+    }
+    pendingFree_.clear();
 }
 
 void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin,
@@ -253,11 +271,7 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candid
         }
         return true;
     });
-    for (ObjectId slot : pendingFree_) {
-        state_[slot] = SlotState::Free;
-        freeSlots_.push_back(slot);
-    }
-    pendingFree_.clear();
+    releasePendingSlots();
     ++counters_.frames;
     counters_.candidatesLastFrame = candidates;
 }

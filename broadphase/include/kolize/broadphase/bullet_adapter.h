@@ -59,11 +59,13 @@ class BroadphaseAdapter : public btBroadphaseInterface {
                                    int shapeType, void* userPtr, int collisionFilterGroup,
                                    int collisionFilterMask, btDispatcher* dispatcher) override;
     /// Removes the proxy's pairs from the cache first; its memory is reused only after the
-    /// next calculateOverlappingPairs. Throws std::invalid_argument for a foreign proxy.
+    /// next calculateOverlappingPairs (or after 4096 destroys without one). Throws
+    /// std::invalid_argument for a foreign or already destroyed proxy.
     void destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) override;
     /// A bad box is reported and ignored: the proxy keeps its last valid box.
     void setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, const btVector3& aabbMax,
                  btDispatcher* dispatcher) override;
+    /// The last valid box (for a proxy still waiting for one: the rejected creation box).
     void getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVector3& aabbMax) const override;
     btOverlappingPairCache* getOverlappingPairCache() override { return pairCache_; }
     const btOverlappingPairCache* getOverlappingPairCache() const override { return pairCache_; }
@@ -115,6 +117,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     static constexpr ObjectId kChunkMask = (1u << kChunkBits) - 1;
 
     Proxy* checkedProxy(btBroadphaseProxy* proxy, const char* operation) const;
+    void releasePendingSlots();
     /// Returns an empty string for a valid box, else the reason.
     static const char* rejectReason(const btVector3& aabbMin, const btVector3& aabbMax);
     void reportBadAabb(const char* operation, const Proxy& proxy, const btVector3& aabbMin,
