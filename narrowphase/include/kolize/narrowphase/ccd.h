@@ -93,8 +93,10 @@ struct RobustSettings {
     /// of unit scale; scale it with the scene.
     double tolerance = 1e-6;
     /// Maximum number of boxes examined per query before answering `hit` conservatively.
-    /// Bounds the worst-case run time; never causes a false negative.
-    int max_boxes = 20000;
+    /// Bounds the worst-case run time; never causes a false negative. On the benchmark
+    /// only 6-7 of 4324 queries (near-collinear sliding edges) reach the default, and
+    /// raising it to 20000 turns just one of their false positives into a negative.
+    int max_boxes = 2000;
 };
 
 /// Thesis baseline: vertex-face CCD via the coplanarity cubic. May miss collisions.
