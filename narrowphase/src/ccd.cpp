@@ -339,14 +339,15 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             within_tolerance = within_tolerance && hi - lo <= settings.tolerance;
             magnitude[k] = std::max(-lo, hi);
         }
-        if (!excluded && !within_tolerance) {
+        if (!excluded) {
             excluded = excludedAlongNormal(Evaluator::normal(x0, dx, 0.5 * (b.t0 + b.t1)), f, eps,
                                            magnitude);
         }
         if (excluded) {
             continue;
         }
-        if (within_tolerance) {
+        const bool time_resolved = b.t1 - b.t0 <= settings.toi_tolerance || b.t1 - b.t0 < kMinWidth;
+        if (within_tolerance && time_resolved) {
             // Every point of b is within tolerance + 2 eps of a root in max norm, and
             // b.t0 is no later than any box still queued, hence than the true toi.
             result.hit = true;
@@ -377,8 +378,11 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         if (b.v1 - b.v0 < kMinWidth)
             variation[2] = -1.0;
         variation[0] *= kTimeSplitBias;
-        const int d = static_cast<int>(std::max_element(variation.begin(), variation.end()) -
-                                       variation.begin());
+        // A box already within tolerance only needs a narrower time range.
+        const int d = within_tolerance
+                          ? 0
+                          : static_cast<int>(std::max_element(variation.begin(), variation.end()) -
+                                             variation.begin());
         if (variation[d] < 0.0) {
             // Cannot split further without losing exactness: accept conservatively.
             result.hit = true;

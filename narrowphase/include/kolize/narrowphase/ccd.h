@@ -92,6 +92,10 @@ struct RobustSettings {
     /// as a collision: it bounds the false-positive distance. Default 1e-6 suits scenes
     /// of unit scale; scale it with the scene.
     double tolerance = 1e-6;
+    /// A box is accepted only once its time range is at most this wide, so a reported
+    /// `toi` is at most this much earlier than the start of the accepted box's range.
+    /// Matters for slow motions, where F is within `tolerance` over long time ranges.
+    double toi_tolerance = 1e-6;
     /// Maximum number of boxes examined per query before answering `hit` conservatively.
     /// Bounds the worst-case run time; never causes a false negative. On the benchmark
     /// only 6-7 of 4324 queries (near-collinear sliding edges) reach the default, and
