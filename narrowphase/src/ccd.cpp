@@ -384,8 +384,10 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
                           : static_cast<int>(std::max_element(variation.begin(), variation.end()) -
                                              variation.begin());
         if (variation[d] < 0.0) {
-            // Cannot split further without losing exactness: accept conservatively.
+            // Cannot split further without losing exactness: accept conservatively, like
+            // an exhausted budget (the tolerance bound does not apply to this answer).
             result.hit = true;
+            result.budget_exhausted = true;
             result.toi = b.t0;
             return result;
         }

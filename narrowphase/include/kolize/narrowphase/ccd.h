@@ -73,7 +73,8 @@ struct CcdResult {
     double toi = 1.0;  ///< Time of impact in [0, 1] when `hit`; 1 otherwise.
     /// Robust method only: number of (t, u, v) boxes examined (cost measure).
     int boxes = 0;
-    /// Robust method only: the box budget ran out and `hit` was set conservatively.
+    /// Robust method only: the box budget ran out (or a box reached the 2^-45 resolution
+    /// limit before the tolerance) and `hit` was set conservatively.
     bool budget_exhausted = false;
 };
 
