@@ -1,5 +1,7 @@
 #include "kolize/narrowphase/mesh_ccd.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cstdint>
 #include <functional>
@@ -142,6 +144,16 @@ struct TestKeyHash {
     }
 };
 
+/// The thesis's culling predicate: true when vertex v's motion relative to the triangle's
+/// centroid does not point against the triangle's normal at t = 0.
+bool facesAway(const MovingMesh& vm, int v, const MovingMesh& fm, const std::array<int, 3>& f) {
+    const Vec3 n = (fm.start[f[1]] - fm.start[f[0]]).cross(fm.start[f[2]] - fm.start[f[0]]);
+    const Vec3 face_motion = (fm.end[f[0]] + fm.end[f[1]] + fm.end[f[2]] - fm.start[f[0]] -
+                              fm.start[f[1]] - fm.start[f[2]]) /
+                             3.0;
+    return n.dot((vm.end[v] - vm.start[v]) - face_motion) >= 0.0;
+}
+
 uint64_t pack(uint64_t x, uint64_t y) {
     return x << 32 | y;
 }
@@ -189,22 +201,31 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
             for (int i = 0; i < 3; ++i) {
                 // Vertex of A against triangle of B, and vertex of B against triangle of A.
                 if (tested.insert(vertexFaceKey(0, tri_a[i], tb)).second) {
-                    ++best.primitive_queries;
                     const int v = tri_a[i];
-                    VertexFaceQuery q{
-                        {a.start[v], b.start[tri_b[0]], b.start[tri_b[1]], b.start[tri_b[2]]},
-                        {a.end[v], b.end[tri_b[0]], b.end[tri_b[1]], b.end[tri_b[2]]}};
-                    consider(vertexFaceRobust(q, settings.primitive),
-                             ContactFeatures::kVertexAFaceB, {v, -1}, {tb, -1});
+                    if (settings.cull_back_facing && facesAway(a, v, b, tri_b)) {
+                        ++best.culled;
+                    } else {
+                        ++best.primitive_queries;
+                        VertexFaceQuery q{
+                            {a.start[v], b.start[tri_b[0]], b.start[tri_b[1]], b.start[tri_b[2]]},
+                            {a.end[v], b.end[tri_b[0]], b.end[tri_b[1]], b.end[tri_b[2]]}};
+                        consider(vertexFaceRobust(q, settings.primitive),
+                                 ContactFeatures::kVertexAFaceB, {v, -1}, {tb, -1});
+                    }
                 }
                 if (tested.insert(vertexFaceKey(1, tri_b[i], static_cast<int>(ta))).second) {
-                    ++best.primitive_queries;
                     const int v = tri_b[i];
-                    VertexFaceQuery q{
-                        {b.start[v], a.start[tri_a[0]], a.start[tri_a[1]], a.start[tri_a[2]]},
-                        {b.end[v], a.end[tri_a[0]], a.end[tri_a[1]], a.end[tri_a[2]]}};
-                    consider(vertexFaceRobust(q, settings.primitive),
-                             ContactFeatures::kFaceAVertexB, {static_cast<int>(ta), -1}, {v, -1});
+                    if (settings.cull_back_facing && facesAway(b, v, a, tri_a)) {
+                        ++best.culled;
+                    } else {
+                        ++best.primitive_queries;
+                        VertexFaceQuery q{
+                            {b.start[v], a.start[tri_a[0]], a.start[tri_a[1]], a.start[tri_a[2]]},
+                            {b.end[v], a.end[tri_a[0]], a.end[tri_a[1]], a.end[tri_a[2]]}};
+                        consider(vertexFaceRobust(q, settings.primitive),
+                                 ContactFeatures::kFaceAVertexB, {static_cast<int>(ta), -1},
+                                 {v, -1});
+                    }
                 }
             }
             for (int i = 0; i < 3; ++i) {

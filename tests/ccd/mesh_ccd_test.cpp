@@ -73,3 +73,20 @@ TEST(CcdMesh, RejectsInconsistentMeshes) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CcdMesh, BackFaceCullingSkipsTestsButKeepsThisTranslationContact) {
+    const MovingMesh a = cube({0, 0, 0}, {1, 0, 0});
+    const MovingMesh b = cube({1.5, 0.25, 0.25}, {0, 0, 0});
+    MeshCcdSettings cull;
+    cull.cull_back_facing = true;
+    const MeshContact full = meshCcd(a, b);
+    const MeshContact culled = meshCcd(a, b, cull);
+    EXPECT_GT(culled.culled, 0u);
+    EXPECT_LT(culled.primitive_queries, full.primitive_queries);
+    ASSERT_TRUE(culled.hit);  // pure translation of convex shapes: culling is safe here
+    EXPECT_LE(culled.toi, 0.5);
+}
+
+}  // namespace
