@@ -170,8 +170,8 @@ constexpr double kErrorFactor = 64.0 * 0x1p-53;
 /// Covers the absolute error of products that underflow into the subnormal range
 /// (at most 2^-1075 each, a few per corner).
 constexpr double kUnderflowSlack = 1e-300;
-/// Boxes narrower than this in a dimension are not split further in it (keeps every
-/// corner an exact dyadic double).
+/// Boxes narrower than this in a dimension are not split further in it: far above the
+/// spacing of doubles in [0, 1], so a midpoint always lies strictly inside its box.
 constexpr double kMinWidth = 0x1p-45;
 
 /// Weight of the time dimension when choosing which dimension to split (see below).
@@ -311,7 +311,9 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     const Evaluator evaluate;
     CcdResult result;
     std::priority_queue<Box, std::vector<Box>, LaterBox> queue;
-    queue.push({0.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0});
+    // Any double t is evaluated exactly as given, and a rounded midpoint still lies in
+    // [t0, t1], so boxes keep covering [0, max_time] without dyadic end points.
+    queue.push({0.0, std::clamp(settings.max_time, 0.0, 1.0), 0.0, 1.0, 0.0, 1.0, 0});
     Corners f;
     while (!queue.empty()) {
         const Box b = queue.top();

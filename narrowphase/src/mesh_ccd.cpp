@@ -181,6 +181,10 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
     const SweptBvh bvh(boxes_b);
 
     MeshContact best;
+    // Once a contact is known, only earlier ones matter: the primitive tests search
+    // [0, best.toi] (the earliest true contact is either found there or is later than a
+    // reported toi, so the minimum stays no later than the truth).
+    RobustSettings primitive = settings.primitive;
     // Vertices and edges are shared between triangles: test each primitive pair once.
     std::unordered_set<TestKey, TestKeyHash> tested;
     auto consider = [&](const CcdResult& r, ContactFeatures f, std::array<int, 2> fa,
@@ -188,6 +192,7 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
         if (r.hit && (!best.hit || r.toi < best.toi)) {
             best.hit = true;
             best.toi = r.toi;
+            primitive.max_time = std::min(primitive.max_time, r.toi);
             best.features = f;
             best.a = fa;
             best.b = fb;
@@ -209,8 +214,8 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
                         VertexFaceQuery q{
                             {a.start[v], b.start[tri_b[0]], b.start[tri_b[1]], b.start[tri_b[2]]},
                             {a.end[v], b.end[tri_b[0]], b.end[tri_b[1]], b.end[tri_b[2]]}};
-                        consider(vertexFaceRobust(q, settings.primitive),
-                                 ContactFeatures::kVertexAFaceB, {v, -1}, {tb, -1});
+                        consider(vertexFaceRobust(q, primitive), ContactFeatures::kVertexAFaceB,
+                                 {v, -1}, {tb, -1});
                     }
                 }
                 if (tested.insert(vertexFaceKey(1, tri_b[i], static_cast<int>(ta))).second) {
@@ -222,9 +227,8 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
                         VertexFaceQuery q{
                             {b.start[v], a.start[tri_a[0]], a.start[tri_a[1]], a.start[tri_a[2]]},
                             {b.end[v], a.end[tri_a[0]], a.end[tri_a[1]], a.end[tri_a[2]]}};
-                        consider(vertexFaceRobust(q, settings.primitive),
-                                 ContactFeatures::kFaceAVertexB, {static_cast<int>(ta), -1},
-                                 {v, -1});
+                        consider(vertexFaceRobust(q, primitive), ContactFeatures::kFaceAVertexB,
+                                 {static_cast<int>(ta), -1}, {v, -1});
                     }
                 }
             }
@@ -238,8 +242,8 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
                     ++best.primitive_queries;
                     EdgeEdgeQuery q{{a.start[a0], a.start[a1], b.start[b0], b.start[b1]},
                                     {a.end[a0], a.end[a1], b.end[b0], b.end[b1]}};
-                    consider(edgeEdgeRobust(q, settings.primitive), ContactFeatures::kEdgeEdge,
-                             {a0, a1}, {b0, b1});
+                    consider(edgeEdgeRobust(q, primitive), ContactFeatures::kEdgeEdge, {a0, a1},
+                             {b0, b1});
                 }
             }
         });

@@ -168,6 +168,15 @@ TEST(CcdVertexFace, NearMissBeyondToleranceIsNotReported) {
     EXPECT_FALSE(vertexFaceRobust(near, fine).hit);
 }
 
+TEST(CcdVertexFace, MaxTimeLimitsTheSearch) {
+    const auto cross = pointVsTriangle({0.25, 0.25, 1}, {0.25, 0.25, -1});  // toi 1/2
+    RobustSettings early, late;
+    early.max_time = 0.4;
+    late.max_time = 0.6;
+    EXPECT_FALSE(vertexFaceRobust(cross, early).hit);
+    expectRobustHit(vertexFaceRobust(cross, late), 0.5);
+}
+
 TEST(CcdLargeCoordinates, BothKindsFrom1e4To1e6) {
     for (double s : {1e4, 1e5, 1e6}) {
         SCOPED_TRACE(s);

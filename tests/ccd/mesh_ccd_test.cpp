@@ -90,3 +90,32 @@ TEST(CcdMesh, BackFaceCullingSkipsTestsButKeepsThisTranslationContact) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CcdMesh, BackFaceCullingMissesAFaceRotatingOntoAVertexBehindIt) {
+    // A's triangle hinges about the y axis (c swings from (1,0,0) down to (0,0,-1)); its
+    // normal at t = 0 is +z. B is a small triangle below A's initial plane, i.e. behind
+    // the face, which sweeps onto B's vertices -- possible for
+    // non-convex meshes. B's vertex (0.35, 0, -0.34) is reached first, at t = 0.34 / 0.69.
+    // The culling skips every B-vertex test, so only it misses.
+    MovingMesh a;
+    a.start = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}};
+    a.end = {{0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
+    a.triangles = {{0, 1, 2}};
+    MovingMesh b;
+    b.start = {{0.3, 0, -0.3}, {0.32, 0.05, -0.35}, {0.35, 0, -0.34}};
+    b.end = b.start;
+    b.triangles = {{0, 1, 2}};
+    const MeshContact full = meshCcd(a, b);
+    ASSERT_TRUE(full.hit);
+    EXPECT_LE(full.toi, 0.34 / 0.69);
+    EXPECT_GE(full.toi, 0.34 / 0.69 - 1e-4);
+    EXPECT_EQ(full.features, ContactFeatures::kFaceAVertexB);
+    EXPECT_EQ(full.b[0], 2);
+    MeshCcdSettings cull;
+    cull.cull_back_facing = true;
+    EXPECT_FALSE(meshCcd(a, b, cull).hit);
+}
+
+}  // namespace

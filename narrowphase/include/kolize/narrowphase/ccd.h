@@ -97,6 +97,10 @@ struct RobustSettings {
     /// `toi` is at most this much earlier than the start of the accepted box's range.
     /// Matters for slow motions, where F is within `tolerance` over long time ranges.
     double toi_tolerance = 1e-6;
+    /// Only contacts at t <= max_time (in (0, 1]) are searched: the guarantees hold on
+    /// [0, max_time], later contacts are ignored. Lets a caller that already knows an
+    /// earlier contact (e.g. meshCcd) skip work.
+    double max_time = 1.0;
     /// Maximum number of boxes examined per query before answering `hit` conservatively.
     /// Bounds the worst-case run time; never causes a false negative. On the benchmark
     /// only 6-7 of 4324 queries (near-collinear sliding edges) reach the default, and
