@@ -3,7 +3,8 @@
 include(CMakePackageConfigHelpers)
 
 set(KOLIZE_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/kolize")
-install(TARGETS ${KOLIZE_INSTALL_TARGETS}
+get_property(kolize_install_targets GLOBAL PROPERTY KOLIZE_INSTALL_TARGETS)
+install(TARGETS ${kolize_install_targets}
     EXPORT kolizeTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
