@@ -189,9 +189,13 @@ void printTable(const std::string& title, const std::vector<Row>& rows) {
                 std::string(22, '-').c_str(), std::string(10, '-').c_str(),
                 std::string(17, '-').c_str(), std::string(17, '-').c_str());
     for (const Row& row : rows) {
-        std::printf("| %-12s | %14.3f | %20.3f | %8zu | %15zu | %15zu |\n", row.broadphase.c_str(),
-                    row.stepMs, row.broadphaseMs, row.pairs, row.falseNegatives,
-                    row.falsePositives);
+        // A replay has no world step: its step column shows "-".
+        char step[32] = "-";
+        if (row.stepMs >= 0) {
+            std::snprintf(step, sizeof step, "%.3f", row.stepMs);
+        }
+        std::printf("| %-12s | %14s | %20.3f | %8zu | %15zu | %15zu |\n", row.broadphase.c_str(),
+                    step, row.broadphaseMs, row.pairs, row.falseNegatives, row.falsePositives);
     }
     std::fflush(stdout);
 }
@@ -207,6 +211,7 @@ int replayStream(const Options& options) {
     for (const std::string& name : options.broadphases) {
         const kolize::ReplayResult result = kolize::replay(stream, name);
         Row row{name};
+        row.stepMs = -1;
         row.broadphaseMs = 1000 * result.medianFrameSeconds();
         row.pairs = result.frames.empty() ? 0 : result.frames.back().reportedPairs;
         row.falseNegatives = result.totalMissing();
@@ -216,7 +221,7 @@ int replayStream(const Options& options) {
                  static_cast<int>(result.frames.size()));
     }
     printTable("replay of " + options.replay + " (" + std::to_string(stream.frames()) +
-                   " frames; step ms not applicable; broadphase ms = setAabb calls + pairs)",
+                   " frames; no world step; broadphase ms = setAabb calls + pairs)",
                rows);
     return 0;
 }
