@@ -2,6 +2,8 @@
 
 #include <kolize/broadphase/brute_force.h>
 #include <kolize/broadphase/bullet_adapter.h>
+#include <kolize/broadphase/range_tree.h>
+#include <kolize/broadphase/segment_tree_set.h>
 
 #include <BulletCollision/BroadphaseCollision/btAxisSweep3.h>
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
@@ -35,13 +37,14 @@ void requireCapacity(std::string_view name, int maxProxies, int limit) {
 }  // namespace
 
 const std::vector<std::string>& broadphaseNames() {
-    static const std::vector<std::string> names = {"brute-force", "dbvt",  "sap",
-                                                   "sap-noray",   "sap32", "simple"};
+    static const std::vector<std::string> names = {"brute-force", "segment-trees", "range-tree",
+                                                   "dbvt",        "sap",           "sap-noray",
+                                                   "sap32",       "simple"};
     return names;
 }
 
 bool isExactBroadphase(std::string_view name) {
-    return name == "brute-force";
+    return name == "brute-force" || name == "segment-trees" || name == "range-tree";
 }
 
 std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
@@ -49,6 +52,14 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
     if (name == "brute-force") {
         return std::make_unique<CoreBroadphase<BruteForce<3, btScalar>>>(std::string(name),
                                                                          settings);
+    }
+    if (name == "segment-trees") {
+        return std::make_unique<CoreBroadphase<SegmentTreeSet<3, btScalar>>>(
+            std::string(name), settings, settings.segmentTrees);
+    }
+    if (name == "range-tree") {
+        return std::make_unique<CoreBroadphase<RangeTree<3, btScalar>>>(std::string(name), settings,
+                                                                        settings.rangeTree);
     }
     if (name == "dbvt") {
         return std::make_unique<btDbvtBroadphase>(settings.pairCache);

@@ -21,6 +21,9 @@ namespace kolize {
 
 /// Makes the broadphase called `name`. Names (see broadphaseNames()):
 /// - "brute-force": kolize's exact reference (tests every pair; O(N^2) per frame).
+/// - "segment-trees": the thesis's set of segment trees, one per axis (settings.segmentTrees).
+/// - "range-tree": the thesis's range tree, one segment tree with sorted node lists
+///   (settings.rangeTree).
 /// - "dbvt": Bullet's btDbvtBroadphase.
 /// - "sap": Bullet's btAxisSweep3 over settings.worldMin/worldMax, with its ray accelerator.
 /// - "sap-noray": the same without the ray accelerator.

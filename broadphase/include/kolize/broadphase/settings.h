@@ -2,6 +2,8 @@
 /// \file
 /// Settings shared by every broadphase the factory makes, with documented defaults.
 
+#include <kolize/broadphase/tree_settings.h>
+
 #include <LinearMath/btVector3.h>
 
 #include <functional>
@@ -49,6 +51,12 @@ struct BroadphaseSettings {
     /// its first valid setAabb. Empty (the default): print the report's message() on stderr,
     /// the first 16 times per broadphase, then count silently (see printStats()).
     std::function<void(const BadAabbReport&)> onBadAabb;
+
+    // --- The segment-tree cores (tree_settings.h documents the fields) ---
+    /// "segment-trees": leaf width (S = 1000 by default) and traversal.
+    SegmentTreeSettings segmentTrees;
+    /// "range-tree": leaf width (S = 1000 by default), tree axis, sorted-list search.
+    RangeTreeSettings rangeTree;
 };
 
 }  // namespace kolize
