@@ -2,6 +2,8 @@
 /// \file
 /// Settings shared by every broadphase the factory makes, with documented defaults.
 
+#include <kolize/broadphase/cell_grid_settings.h>
+
 #include <LinearMath/btVector3.h>
 
 #include <functional>
@@ -49,6 +51,9 @@ struct BroadphaseSettings {
     /// its first valid setAabb. Empty (the default): print the report's message() on stderr,
     /// the first 16 times per broadphase, then count silently (see printStats()).
     std::function<void(const BadAabbReport&)> onBadAabb;
+
+    /// Cell size, region and overflow rules of "grid", "spatial-tree" and "spatial-hash".
+    CellGridSettings cells;
 };
 
 }  // namespace kolize
