@@ -2,6 +2,7 @@
 
 #include <kolize/broadphase/brute_force.h>
 #include <kolize/broadphase/bullet_adapter.h>
+#include <kolize/broadphase/cell_grid.h>
 #include <kolize/broadphase/range_tree.h>
 #include <kolize/broadphase/segment_tree_set.h>
 
@@ -37,18 +38,31 @@ void requireCapacity(std::string_view name, int maxProxies, int limit) {
 }  // namespace
 
 const std::vector<std::string>& broadphaseNames() {
-    static const std::vector<std::string> names = {"brute-force", "segment-trees", "range-tree",
-                                                   "dbvt",        "sap",           "sap-noray",
-                                                   "sap32",       "simple"};
+    static const std::vector<std::string> names = {
+        "grid", "spatial-tree", "spatial-hash", "segment-trees", "range-tree", "brute-force",
+        "dbvt", "sap",          "sap-noray",    "sap32",         "simple"};
     return names;
 }
 
 bool isExactBroadphase(std::string_view name) {
-    return name == "brute-force" || name == "segment-trees" || name == "range-tree";
+    return name == "grid" || name == "spatial-tree" || name == "spatial-hash" ||
+           name == "segment-trees" || name == "range-tree" || name == "brute-force";
 }
 
 std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
                                                       const BroadphaseSettings& settings) {
+    if (name == "grid") {
+        return std::make_unique<CoreBroadphase<UniformGrid<3, btScalar>>>(std::string(name),
+                                                                          settings, settings.cells);
+    }
+    if (name == "spatial-tree") {
+        return std::make_unique<CoreBroadphase<SpatialTree<3, btScalar>>>(std::string(name),
+                                                                          settings, settings.cells);
+    }
+    if (name == "spatial-hash") {
+        return std::make_unique<CoreBroadphase<SpatialHash<3, btScalar>>>(std::string(name),
+                                                                          settings, settings.cells);
+    }
     if (name == "brute-force") {
         return std::make_unique<CoreBroadphase<BruteForce<3, btScalar>>>(std::string(name),
                                                                          settings);

@@ -3,7 +3,7 @@
 /// kolize: drop-in replacements for Bullet's broadphase.
 ///
 ///     #include <kolize/kolize.h>
-///     auto broadphase = kolize::makeBroadphase("brute-force");
+///     auto broadphase = kolize::makeBroadphase("grid");
 ///     btDiscreteDynamicsWorld world(dispatcher, broadphase.get(), solver, configuration);
 ///
 /// Bullet's own broadphases are available under the same factory for comparison.
@@ -20,6 +20,12 @@
 namespace kolize {
 
 /// Makes the broadphase called `name`. Names (see broadphaseNames()):
+/// - "grid": uniform grid (thesis method A): a dense array of cells over a region chosen
+///   from the objects, with an overflow set for huge and outside objects. Best for
+///   objects spread evenly. Settings: settings.cells.
+/// - "spatial-tree": regular spatial tree (method B): only non-empty cells, in an AVL tree;
+///   unbounded. Settings: settings.cells.
+/// - "spatial-hash": the same sparse cells in a hash table; unbounded.
 /// - "brute-force": kolize's exact reference (tests every pair; O(N^2) per frame).
 /// - "segment-trees": the thesis's set of segment trees, one per axis (settings.segmentTrees).
 /// - "range-tree": the thesis's range tree, one segment tree with sorted node lists

@@ -12,8 +12,8 @@
 /// validate(): every live object's cell box is exactly clamp(cells(box), windows).
 ///
 /// Tuning: the first insert, and every insert that doubles the live count since the last
-/// tuning, recomputes U (tuneScene); when it changed by more than 1.5x the trees are rebuilt.
-/// That is amortised O(1) per insert and keeps U fitted to a scene that is built up over time.
+/// tuning, recomputes U (tuneScene); when it changed, the trees are rebuilt. That is
+/// amortised O(log N) per insert and keeps U fitted to a scene that is built up over time.
 
 #include <kolize/broadphase/aabb.h>
 #include <kolize/broadphase/segment_tree.h>
@@ -154,6 +154,14 @@ class CellCore {
     /// The cell box of live object `id`.
     const CellBox<D>& cellsOf(ObjectId id) const { return cells_[id]; }
 
+    /// Calls `visit(id)` once for every live object whose cells meet the ray's bounds
+    /// (rayBounds), through the derived core's queryBox; the adapter's exact test does the
+    /// rest.
+    template <class Visit>
+    void queryRay(const Ray<D, Scalar>& ray, Visit&& visit) const {
+        derived().queryBox(rayBounds(ray), visit);
+    }
+
     /// The box a ray query must cover: the segment's bounds (with a relative margin for the
     /// rounding in Bullet's slab test), grown by the swept box as expandedForRay does.
     static Box rayBounds(const Ray<D, Scalar>& ray) {
@@ -214,6 +222,18 @@ class CellCore {
         if (present != live_.size()) {
             throw std::logic_error(what + ": live list and index disagree");
         }
+    }
+
+    /// For SegmentTree::validate: the stored cell range on `axis` of a live object.
+    auto storedRangeOn(int axis) const {
+        return [this, axis](ObjectId id, std::int64_t& lo, std::int64_t& hi) {
+            if (!isLive(id)) {
+                return false;
+            }
+            lo = cells_[id].lo[axis];
+            hi = cells_[id].hi[axis];
+            return true;
+        };
     }
 
     bool isLive(ObjectId id) const { return id < position_.size() && position_[id] != kAbsent; }
@@ -286,8 +306,7 @@ class CellCore {
     void retune() {
         const TunedScene scene = tuneScene(boxes_, live_, tuning_, scratch_);
         tunedCount_ = live_.size();
-        const double ratio = scene.unit / quantizer_.unit();
-        if (built_ && ratio < 1.5 && ratio > 1 / 1.5) {
+        if (built_ && scene.unit == quantizer_.unit()) {
             // Keep the trees; store the newest object as insert would have.
             const ObjectId id = live_.back();
             const CellBox<D> raw = rawCells(boxes_[id]);

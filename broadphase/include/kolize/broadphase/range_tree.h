@@ -110,12 +110,6 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         });
     }
 
-    /// Calls `visit(id)` once for every live object whose cells meet the ray's bounds.
-    template <class Visit>
-    void queryRay(const Ray<D, Scalar>& ray, Visit&& visit) const {
-        queryBox(Base::rayBounds(ray), visit);
-    }
-
     /// Checks the tree, the entries, and that every node not awaiting a sort is sorted and
     /// knows its widest entry; throws std::logic_error.
     void validate() const {
@@ -124,15 +118,7 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
             return;
         }
         tree_.validate(
-            "RangeTree", this->live().size(),
-            [&](ObjectId id, std::int64_t& lo, std::int64_t& hi) {
-                if (!this->isLive(id)) {
-                    return false;
-                }
-                lo = this->cells(id).lo[treeAxis_];
-                hi = this->cells(id).hi[treeAxis_];
-                return true;
-            },
+            "RangeTree", this->live().size(), this->storedRangeOn(treeAxis_),
             [&](const Entry& e, Index at) {
                 const Entry expected = cellEntry<D>(e.id, this->cells(e.id), treeAxis_);
                 if (expected.otherLo != e.otherLo || expected.otherHi != e.otherHi) {
@@ -160,6 +146,9 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
                order_.capacity() * sizeof(NodeOrder) +
                (marked_.capacity() + path_.capacity() + spine_.capacity()) * sizeof(Index);
     }
+
+    /// Nodes in the tree.
+    std::size_t nodeCount() const { return tree_.liveNodes(); }
 
   private:
     /// Per node: the widest entry on the sorted axis (an upper bound), and whether the node

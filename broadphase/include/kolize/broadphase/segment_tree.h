@@ -64,9 +64,12 @@ struct TunedScene {
     double unit = 1;
 };
 
-/// Tunes U for the boxes `ids` of `boxes` (see CellTuning). The width floor U >= median
-/// object width / 16 keeps a scene whose objects all sit near the origin from getting
-/// absurdly fine cells. O(N). Scratch vectors are reused.
+/// Tunes U for the boxes `ids` of `boxes` (see CellTuning): D = 1.5 x the largest distance
+/// of a box centre from the origin, ignoring centres more than twice as far as the 99th
+/// percentile (so the thesis's D for its scenes, but a few far objects do not coarsen
+/// everyone's cells). The width floor U >= median object width / 16 keeps a scene whose
+/// objects all sit near the origin from getting absurdly fine cells. O(N). `scratch` is
+/// reused.
 template <int D, class Scalar>
 TunedScene tuneScene(const std::vector<Aabb<D, Scalar>>& boxes, const std::vector<ObjectId>& ids,
                      const CellTuning& tuning, std::vector<double>& scratch) {
@@ -86,7 +89,14 @@ TunedScene tuneScene(const std::vector<Aabb<D, Scalar>>& boxes, const std::vecto
     }
     const std::size_t at = (scratch.size() - 1) * 99 / 100;
     std::nth_element(scratch.begin(), scratch.begin() + at, scratch.end());
-    out.halfExtent = 1.5 * scratch[at];
+    const double inlierLimit = 2 * scratch[at];
+    double farthest = 0;
+    for (double distance : scratch) {
+        if (distance <= inlierLimit) {
+            farthest = std::max(farthest, distance);
+        }
+    }
+    out.halfExtent = 1.5 * farthest;
 
     scratch.clear();
     for (ObjectId id : ids) {

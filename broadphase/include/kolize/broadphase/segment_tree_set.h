@@ -99,13 +99,6 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         });
     }
 
-    /// Calls `visit(id)` once for every live object whose cells meet the ray's bounds
-    /// (CellCore::rayBounds); the adapter's exact test does the rest.
-    template <class Visit>
-    void queryRay(const Ray<D, Scalar>& ray, Visit&& visit) const {
-        queryBox(Base::rayBounds(ray), visit);
-    }
-
     /// Checks every tree against the objects' cell boxes; throws std::logic_error.
     void validate() const {
         this->validateObjects("SegmentTreeSet");
@@ -115,15 +108,7 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         for (int axis = 0; axis < D; ++axis) {
             trees_[axis].validate(
                 "SegmentTreeSet axis " + std::to_string(axis), this->live().size(),
-                [&](ObjectId id, std::int64_t& lo, std::int64_t& hi) {
-                    if (!this->isLive(id)) {
-                        return false;
-                    }
-                    lo = this->cells(id).lo[axis];
-                    hi = this->cells(id).hi[axis];
-                    return true;
-                },
-                [&](const Entry& e, Index) {
+                this->storedRangeOn(axis), [&](const Entry& e, Index) {
                     const Entry expected = cellEntry<D>(e.id, this->cells(e.id), axis);
                     if (expected.otherLo != e.otherLo || expected.otherHi != e.otherHi) {
                         throw std::logic_error("SegmentTreeSet axis " + std::to_string(axis) +
@@ -143,6 +128,18 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         }
         return bytes;
     }
+
+    /// Nodes in all trees.
+    std::size_t nodeCount() const {
+        std::size_t count = 0;
+        for (const Tree& tree : trees_) {
+            count += tree.liveNodes();
+        }
+        return count;
+    }
+
+    /// Nodes holding object `id`'s entries on `axis` (its canonical decomposition).
+    std::size_t nodesOf(ObjectId id, int axis) const { return trees_[axis].refsOf(id).size(); }
 
     /// The axis the stabbing traversal uses now.
     int stabbingAxis() const { return axis_; }

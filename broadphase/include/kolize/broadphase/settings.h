@@ -2,6 +2,7 @@
 /// \file
 /// Settings shared by every broadphase the factory makes, with documented defaults.
 
+#include <kolize/broadphase/cell_grid_settings.h>
 #include <kolize/broadphase/tree_settings.h>
 
 #include <LinearMath/btVector3.h>
@@ -51,6 +52,9 @@ struct BroadphaseSettings {
     /// its first valid setAabb. Empty (the default): print the report's message() on stderr,
     /// the first 16 times per broadphase, then count silently (see printStats()).
     std::function<void(const BadAabbReport&)> onBadAabb;
+
+    /// Cell size, region and overflow rules of "grid", "spatial-tree" and "spatial-hash".
+    CellGridSettings cells;
 
     // --- The segment-tree cores (tree_settings.h documents the fields) ---
     /// "segment-trees": leaf width (S = 1000 by default) and traversal.

@@ -9,8 +9,9 @@ namespace kolize {
 struct CellTuning {
     /// S: the tuned scene extent 2D is cut into this many leaf cells. D is thesis formula
     /// 3.3, 1.5 x the distance of the farthest object from the origin, except that kolize
-    /// takes the 99th percentile of the box centres' distances so that a few far objects do
-    /// not coarsen everyone's cells. More cells: fewer false candidates, deeper trees. The
+    /// ignores box centres more than twice as far as the 99th percentile of the distances,
+    /// so that a few far objects do not coarsen everyone's cells. More cells: fewer false
+    /// candidates, deeper trees. The
     /// thesis chose 1000 (its table 2.1: 2000 marginally faster, 1000 less memory).
     /// U is tuned at the first insert and again whenever the live count has doubled since.
     int divisions = 1000;
