@@ -8,7 +8,12 @@
 
 #include <kolize/broadphase/range_tree.h>
 #include <kolize/broadphase/segment_tree_set.h>
+#include <kolize/engine/falling_boxes.h>
+#include <kolize/engine/pair_stream.h>
 #include <kolize/engine/thesis_scene.h>
+#include <kolize/kolize.h>
+
+#include <btBulletDynamicsCommon.h>
 
 #include <gtest/gtest.h>
 
@@ -350,6 +355,107 @@ TEST(TreeCores, TouchingBoxesAndPointsAreCandidates) {
             EXPECT_NE(pair.first, 4u);
         }
     }
+}
+
+/// Replays `stream` into the tree broadphases; no false negative, no false positive.
+void expectExactReplay(const PairStream& stream, std::size_t minPairs) {
+    for (const char* name : {"segment-trees", "range-tree"}) {
+        const ReplayResult result = replay(stream, name);
+        ASSERT_EQ(result.frames.size(), stream.frames()) << name;
+        EXPECT_EQ(result.totalMissing(), 0u) << name;
+        EXPECT_EQ(result.totalExtra(), 0u) << name;
+        std::size_t truePairs = 0;
+        for (const ReplayFrame& frame : result.frames) {
+            truePairs += frame.truePairs;
+        }
+        EXPECT_GT(truePairs, minPairs) << name << ": the stream should have pairs";
+    }
+}
+
+// A recorded world in which every fourth box is shot away, some at 1e3 and some at 1e6
+// units per second: they leave the initial scene (and any tuned root) within frames.
+TEST(TreeStreams, WorldWithBoxesShotFarAwayReplaysExactly) {
+    PairStream stream;
+    FallingBoxesSettings settings;
+    settings.layers = 4;
+    settings.boxesPerRow = 5;
+    settings.groundIsPlane = true;
+    {
+        auto inner = makeBroadphase("brute-force");
+        auto* recorder = new RecordingBroadphase(*inner, stream);
+        FallingBoxesWorld world(std::unique_ptr<btBroadphaseInterface>(recorder), settings);
+        for (int step = 0; step < 90; ++step) {
+            if (step == 30) {
+                int shot = 0;
+                for (btRigidBody* body : world.bodies()) {
+                    if (body->getInvMass() > 0 && shot++ % 4 == 0) {
+                        const btScalar speed = shot % 8 == 1 ? 1e6 : 1e3;
+                        body->setLinearVelocity(btVector3(speed, speed * 0.5f, -speed));
+                        body->setCcdMotionThreshold(0);
+                    }
+                }
+            }
+            world.step();
+        }
+    }
+    expectExactReplay(stream, 500);
+}
+
+// A synthetic stream: pairs of overlapping boxes fly out along every axis to 1e29 (past
+// the cell limits) and back, over a plane; objects are created and destroyed on the way.
+TEST(TreeStreams, ObjectsFlyingPastTheCellLimitsReplayExactly) {
+    PairStream stream;
+    stream.scalarBytes = 8;
+    auto event = [&](StreamEvent::Op op, std::uint32_t object, const double lo[3],
+                     const double hi[3]) {
+        StreamEvent e;
+        e.op = op;
+        e.object = object;
+        e.group = 1;
+        e.mask = -1;
+        for (int axis = 0; axis < 3; ++axis) {
+            e.aabbMin[axis] = lo[axis];
+            e.aabbMax[axis] = hi[axis];
+        }
+        stream.events.push_back(e);
+    };
+    const double planeLo[3] = {-1e18, -1e18, -1e18}, planeHi[3] = {1e18, 1e18, 1e18};
+    const double zero[3] = {0, 0, 0};
+    event(StreamEvent::Op::Create, 0, planeLo, planeHi);
+    std::uint32_t objects = 1;
+    for (int i = 0; i < 60; ++i, ++objects) {
+        const double lo[3] = {double(i % 6) * 2, double(i / 6) * 2, 0};
+        const double hi[3] = {lo[0] + 1.5, lo[1] + 1.5, 1.5};
+        event(StreamEvent::Op::Create, objects, lo, hi);
+    }
+    for (int frame = 0; frame < 120; ++frame) {
+        // Distance grows by 10x every 4 frames up to 1e30, then comes back.
+        const int phase = frame < 60 ? frame : 119 - frame;
+        const double distance = std::pow(10.0, phase / 2.0);
+        for (std::uint32_t object = 1; object < 61; ++object) {
+            if (object % 3 == 2) {
+                continue;  // stays home
+            }
+            // Objects 3k and 3k + 1 (neighbours, overlapping) fly together.
+            const std::uint32_t group = object / 3;
+            const int axis = int(group % 3);
+            const double sign = group % 2 ? 1 : -1;
+            double lo[3] = {double((object - 1) % 6) * 2, double((object - 1) / 6) * 2, 0};
+            lo[axis] += sign * distance * (1 + 0.001 * group);
+            const double hi[3] = {lo[0] + 2.5, lo[1] + 2.5, lo[2] + 2.5};
+            event(StreamEvent::Op::SetAabb, object, lo, hi);
+        }
+        if (frame % 10 == 5) {  // replace the object created last time (none of the fliers)
+            if (objects > 61) {
+                event(StreamEvent::Op::Destroy, objects - 1, zero, zero);
+            }
+            const double lo[3] = {double(frame), 0, 0}, hi[3] = {double(frame) + 3, 3, 3};
+            event(StreamEvent::Op::Create, objects, lo, hi);
+            ++objects;
+        }
+        event(StreamEvent::Op::EndFrame, 0, zero, zero);
+    }
+    expectExactReplay(stream, 1000);
 }
 
 }  // namespace
