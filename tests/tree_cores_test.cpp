@@ -33,16 +33,6 @@ Pair ordered(ObjectId a, ObjectId b) {
     return a < b ? Pair{a, b} : Pair{b, a};
 }
 
-template <int D>
-bool cellsOverlap(const CellBox<D>& a, const CellBox<D>& b) {
-    for (int axis = 0; axis < D; ++axis) {
-        if (a.lo[axis] > b.hi[axis] || b.lo[axis] > a.hi[axis]) {
-            return false;
-        }
-    }
-    return true;
-}
-
 template <class Core>
 std::set<Pair> candidatesOf(Core& core) {
     std::set<Pair> out;

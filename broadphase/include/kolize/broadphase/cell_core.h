@@ -11,16 +11,19 @@
 /// and when one grows every clamped object is clamped again. Invariant, checked by
 /// validate(): every live object's cell box is exactly clamp(cells(box), windows).
 ///
-/// Tuning: the first insert, and every insert that doubles the live count since the last
-/// tuning, recomputes U (tuneScene); when it changed, the trees are rebuilt. That is
-/// amortised O(log N) per insert and keeps U fitted to a scene that is built up over time.
+/// Tuning: the first insert, every insert that doubles the live count since the last
+/// tuning, and the first findCandidates after the count grew by a quarter recompute U
+/// (tuneScene); when it changed, the trees are rebuilt. That is amortised O(log N) per
+/// insert and keeps U fitted to a scene that is built up over time.
 
 #include <kolize/broadphase/aabb.h>
+#include <kolize/broadphase/pair_set.h>
 #include <kolize/broadphase/segment_tree.h>
 
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -77,6 +80,26 @@ inline bool othersOverlap(const CellEntry<D>& a, const CellEntry<D>& b, int from
     return true;
 }
 
+/// Whether two cell boxes overlap on every axis.
+template <int D>
+inline bool cellsOverlap(const CellBox<D>& a, const CellBox<D>& b) {
+    for (int axis = 0; axis < D; ++axis) {
+        if (a.lo[axis] > b.hi[axis] || b.lo[axis] > a.hi[axis]) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/// Candidates kept between frames (when `incremental` is on). The candidate set is the
+/// pairs whose cell boxes overlap, and cell boxes change rarely when objects move little:
+/// so the set of the last frame is kept, each object whose cell box changed adds the pairs
+/// its box grew into (queries of the grown slabs only), and pairs whose cell boxes no longer
+/// overlap are dropped while the set is read. Every pair that overlaps now either
+/// overlapped before or lies in the grown part of one of its two objects, so nothing is
+/// missed. When many objects changed cells, the derived core enumerates all pairs instead,
+/// and keeps them when the motion is slow enough that the next frame can be incremental.
+///
 /// Derived must provide (all called by CellCore only):
 ///   bool hasTree(int axis) const;
 ///   SegmentTree<...>& treeOf(int axis);  const version too
@@ -84,12 +107,16 @@ inline bool othersOverlap(const CellEntry<D>& a, const CellEntry<D>& b, int from
 ///   void store(ObjectId id);                        — add entries for cells(id)
 ///   void unstore(ObjectId id);                      — remove all of id's entries
 ///   void restore(ObjectId id, const CellBox<D>& old);  — cells(id) changed from `old`
+///   void visitCells(const CellBox<D>& query, Visit&& visit) const;
+///                                      — each object whose cell box overlaps `query`, once
+///   void enumerateAll(Sink&& candidate);  — every cell-overlap pair, once
 template <class Derived, int D, class Scalar>
 class CellCore {
   public:
     using Box = Aabb<D, Scalar>;
 
-    explicit CellCore(const CellTuning& tuning) : tuning_(tuning) {
+    CellCore(const CellTuning& tuning, bool incremental)
+        : tuning_(tuning), incremental_(incremental) {
         if (tuning.unit < 0 || !std::isfinite(tuning.unit) || tuning.divisions < 1) {
             throw std::invalid_argument(
                 "kolize: cell tuning needs divisions >= 1 and a finite unit >= 0 (0 = tune)");
@@ -102,27 +129,26 @@ class CellCore {
         if (id >= boxes_.size()) {
             boxes_.resize(id + 1);
             cells_.resize(id + 1);
+            stay_.resize(id + 1);
             position_.resize(id + 1, kAbsent);
         }
         boxes_[id] = box;
         position_[id] = static_cast<std::uint32_t>(live_.size());
         live_.push_back(id);
-        if (!built_ || live_.size() >= 2 * tunedCount_) {
-            retune();
-            return;
+        if ((!built_ || live_.size() >= 2 * tunedCount_) && retune()) {
+            return;  // rebuilt, `id` included
         }
-        const CellBox<D> raw = rawCells(box);
-        if (growFor(raw)) {
-            reclampAll(id);
-        }
-        cells_[id] = clamped(raw);
-        derived().store(id);
+        place(id);
     }
 
     /// Moves live object `id` to `box`. Nothing structural happens while its cell box stays.
     void update(ObjectId id, const Box& box) {
         boxes_[id] = box;
+        if (staysInItsCells(id, box)) {
+            return;
+        }
         const CellBox<D> raw = rawCells(box);
+        stay_[id] = stayOf(raw);
         if (growFor(raw)) {
             reclampAll(id);
         }
@@ -131,6 +157,7 @@ class CellCore {
             const CellBox<D> old = cells_[id];
             cells_[id] = next;
             derived().restore(id, old);
+            noteChange(id, &old);
         }
     }
 
@@ -179,6 +206,56 @@ class CellCore {
     }
 
   protected:
+    /// The derived core's findCandidates: every pair whose cell boxes overlap, once, from
+    /// the kept set or from derived().enumerateAll (see the class comment).
+    template <class Sink>
+    void emitCandidates(Sink& candidate) {
+        retuneBeforeFrame();
+        const std::size_t n = live_.size();
+        if (keptValid_ && !changesOverflowed_ && changes_.size() * kIncrementalShare <= n) {
+            for (const Change& change : changes_) {
+                if (isLive(change.id)) {
+                    addGrownPairs(change);
+                }
+            }
+            kept_.retainIf([&](PairSet::Entry& entry) {
+                const ObjectId a = entry.first(), b = entry.second();
+                if (!isLive(a) || !isLive(b) || !cellsOverlap(cells_[a], cells_[b])) {
+                    return false;
+                }
+                candidate(a, b);
+                return true;
+            });
+        } else {
+            const bool keep = incremental_ && !changesOverflowed_;
+            if (keep) {
+                kept_.clear();
+            }
+            derived().enumerateAll([&](ObjectId a, ObjectId b) {
+                candidate(a, b);
+                if (keep) {
+                    bool inserted = false;
+                    kept_.findOrInsert(a, b, inserted);
+                }
+            });
+            keptValid_ = keep;
+        }
+        for (const Change& change : changes_) {
+            changeIndex_[change.id] = 0;
+        }
+        changes_.clear();
+        changesOverflowed_ = false;
+    }
+
+    /// Called by the derived core before finding pairs: retunes when the live count has
+    /// grown by a quarter since the last tuning (a scene loaded object by object gets the
+    /// U of the whole scene at its first frame). Amortised O(1) per insert.
+    void retuneBeforeFrame() {
+        if (live_.size() >= 2 && live_.size() * 4 >= tunedCount_ * 5) {
+            retune();
+        }
+    }
+
     Derived& derived() { return static_cast<Derived&>(*this); }
     const Derived& derived() const { return static_cast<const Derived&>(*this); }
 
@@ -186,7 +263,7 @@ class CellCore {
     /// overlapping `box` overlaps too.
     /// A NaN bound counts as unbounded on its side, as the exact test lets it overlap all;
     /// an inverted box [lo > hi] as [hi, lo], which every box the exact test accepts covers.
-    CellBox<D> queryCells(Box box) const {
+    CellBox<D> cellsForQuery(Box box) const {
         for (int axis = 0; axis < D; ++axis) {
             if (box.lo[axis] > box.hi[axis]) {
                 std::swap(box.lo[axis], box.hi[axis]);
@@ -240,8 +317,11 @@ class CellCore {
 
     std::size_t objectMemoryBytes() const {
         return boxes_.capacity() * sizeof(Box) + cells_.capacity() * sizeof(CellBox<D>) +
-               (position_.capacity() + live_.capacity()) * sizeof(std::uint32_t) +
-               scratch_.capacity() * sizeof(double);
+               stay_.capacity() * sizeof(Stay) +
+               (position_.capacity() + live_.capacity() + changeIndex_.capacity()) *
+                   sizeof(std::uint32_t) +
+               scratch_.capacity() * sizeof(double) + kept_.memoryBytes() +
+               changes_.capacity() * sizeof(Change);
     }
 
     const std::vector<ObjectId>& live() const { return live_; }
@@ -249,6 +329,66 @@ class CellCore {
 
   private:
     static constexpr std::uint32_t kAbsent = 0xffffffffu;
+    /// The kept set is updated when at most 1 / kIncrementalShare of the objects changed
+    /// cells; changes beyond 1 / kKeepShare are not recorded and the next frame enumerates
+    /// everything without keeping it (fast motion: keeping would not pay).
+    static constexpr std::size_t kIncrementalShare = 4;
+    static constexpr std::size_t kKeepShare = 2;
+
+    /// An object whose cell box changed since the last frame: its box then (`old`), or
+    /// `inserted` when it was not there.
+    struct Change {
+        ObjectId id = 0;
+        bool inserted = false;
+        CellBox<D> old;
+    };
+
+    void noteChange(ObjectId id, const CellBox<D>* old) {
+        if (!incremental_ || changesOverflowed_) {
+            return;
+        }
+        if (id >= changeIndex_.size()) {
+            changeIndex_.resize(id + 1, 0);
+        }
+        if (changeIndex_[id] != 0) {
+            changes_[changeIndex_[id] - 1].inserted |= old == nullptr;
+            return;
+        }
+        if (changes_.size() * kKeepShare > live_.size()) {
+            changesOverflowed_ = true;
+            return;
+        }
+        changes_.push_back(Change{id, old == nullptr, old != nullptr ? *old : CellBox<D>{}});
+        changeIndex_[id] = static_cast<std::uint32_t>(changes_.size());
+    }
+
+    /// Adds to the kept set the pairs of `change.id` whose cells overlap its grown part.
+    void addGrownPairs(const Change& change) {
+        const ObjectId id = change.id;
+        const CellBox<D>& now = cells_[id];
+        auto add = [&](ObjectId other) {
+            if (other != id) {
+                bool inserted = false;
+                kept_.findOrInsert(id, other, inserted);
+            }
+        };
+        if (change.inserted) {
+            derived().visitCells(now, add);
+            return;
+        }
+        for (int axis = 0; axis < D; ++axis) {
+            if (now.lo[axis] < change.old.lo[axis]) {
+                CellBox<D> slab = now;
+                slab.hi[axis] = std::min(now.hi[axis], Cell(change.old.lo[axis] - 1));
+                derived().visitCells(slab, add);
+            }
+            if (now.hi[axis] > change.old.hi[axis]) {
+                CellBox<D> slab = now;
+                slab.lo[axis] = std::max(now.lo[axis], Cell(change.old.hi[axis] + 1));
+                derived().visitCells(slab, add);
+            }
+        }
+    }
 
     CellBox<D> rawCells(const Box& box) const {
         CellBox<D> out;
@@ -259,32 +399,83 @@ class CellCore {
         return out;
     }
 
+    /// The coordinates for which the raw cells certainly stay what they are: per axis and
+    /// bound, box.lo[axis] in [loLower, loUpper] and box.hi[axis] in [hiLower, hiUpper].
+    /// A few comparisons instead of a quantisation, for the many objects that move
+    /// within their cells.
+    struct Stay {
+        std::array<Scalar, D> loLower, loUpper, hiLower, hiUpper;
+    };
+
+    bool staysInItsCells(ObjectId id, const Box& box) const {
+        const Stay& stay = stay_[id];
+        bool inside = true;
+        for (int axis = 0; axis < D; ++axis) {
+            inside &= box.lo[axis] >= stay.loLower[axis] && box.lo[axis] <= stay.loUpper[axis] &&
+                      box.hi[axis] >= stay.hiLower[axis] && box.hi[axis] <= stay.hiUpper[axis];
+        }
+        return inside;
+    }
+
+    Stay stayOf(const CellBox<D>& raw) const {
+        Stay out;
+        for (int axis = 0; axis < D; ++axis) {
+            stayInterval(raw.lo[axis], out.loLower[axis], out.loUpper[axis]);
+            stayInterval(raw.hi[axis], out.hiLower[axis], out.hiUpper[axis]);
+        }
+        return out;
+    }
+
+    /// [lower, upper]: values whose cell is certainly `cell`, i.e. [cell U, (cell + 1) U)
+    /// shrunk by a relative margin of 1e-6: far above the rounding of x / U and of the
+    /// conversion to a float Scalar, far below what makes a difference to how often the
+    /// shortcut applies. The saturated cells +-(kCellLimit + 1) are open on their far side.
+    void stayInterval(Cell cell, Scalar& lower, Scalar& upper) const {
+        constexpr Scalar kInfinity = std::numeric_limits<Scalar>::infinity();
+        const double unit = quantizer_.unit();
+        const double from = double(cell) * unit, to = from + unit;
+        lower = cell <= -kCellLimit - 1
+                    ? -kInfinity
+                    : static_cast<Scalar>(from + 1e-6 * (std::fabs(from) + unit));
+        upper = cell >= kCellLimit + 1 ? kInfinity
+                                       : static_cast<Scalar>(to - 1e-6 * (std::fabs(to) + unit));
+    }
+
     static bool withinLimits(Cell lo, Cell hi) { return lo >= -kCellLimit && hi <= kCellLimit; }
 
     /// Grows each tree to cover the raw range on its axis when that is within the limits.
     bool growFor(const CellBox<D>& raw) {
         bool grew = false;
         for (int axis = 0; axis < D; ++axis) {
-            if (derived().hasTree(axis) && withinLimits(raw.lo[axis], raw.hi[axis])) {
+            if (derived().hasTree(axis) && withinLimits(raw.lo[axis], raw.hi[axis]) &&
+                (raw.lo[axis] < window_.lo[axis] || raw.hi[axis] > window_.hi[axis])) {
                 grew = derived().treeOf(axis).growToCover(raw.lo[axis], raw.hi[axis]) || grew;
             }
+        }
+        if (grew) {
+            refreshWindows();
         }
         return grew;
     }
 
     CellBox<D> clamped(CellBox<D> raw) const {
         for (int axis = 0; axis < D; ++axis) {
-            if (!derived().hasTree(axis)) {
-                continue;
-            }
-            const auto& tree = derived().treeOf(axis);
-            const std::int64_t lo = tree.windowLo(), hi = tree.windowHi();
-            raw.lo[axis] = static_cast<Cell>(
-                std::min<std::int64_t>(std::max<std::int64_t>(raw.lo[axis], lo), hi));
-            raw.hi[axis] = static_cast<Cell>(
-                std::min<std::int64_t>(std::max<std::int64_t>(raw.hi[axis], lo), hi));
+            raw.lo[axis] = std::min(std::max(raw.lo[axis], window_.lo[axis]), window_.hi[axis]);
+            raw.hi[axis] = std::min(std::max(raw.hi[axis], window_.lo[axis]), window_.hi[axis]);
         }
         return raw;
+    }
+
+    /// Copies the trees' windows (an axis without a tree: the saturation limits, where
+    /// clamping changes nothing).
+    void refreshWindows() {
+        for (int axis = 0; axis < D; ++axis) {
+            const bool tree = derived().hasTree(axis);
+            window_.lo[axis] =
+                static_cast<Cell>(tree ? derived().treeOf(axis).windowLo() : -kCellLimit - 1);
+            window_.hi[axis] =
+                static_cast<Cell>(tree ? derived().treeOf(axis).windowHi() : kCellLimit + 1);
+        }
     }
 
     /// After a window grew: clamps every clamped object again (except `skip`, which the
@@ -299,23 +490,30 @@ class CellCore {
                 const CellBox<D> old = cells_[id];
                 cells_[id] = next;
                 derived().restore(id, old);
+                noteChange(id, &old);
             }
         }
     }
 
-    void retune() {
+    /// Stores a newly live object.
+    void place(ObjectId id) {
+        const CellBox<D> raw = rawCells(boxes_[id]);
+        stay_[id] = stayOf(raw);
+        if (growFor(raw)) {
+            reclampAll(id);
+        }
+        cells_[id] = clamped(raw);
+        derived().store(id);
+        noteChange(id, nullptr);
+    }
+
+    /// Tunes U for the live objects; when it changed, rebuilds the trees with every live
+    /// object and returns true.
+    bool retune() {
         const TunedScene scene = tuneScene(boxes_, live_, tuning_, scratch_);
         tunedCount_ = live_.size();
         if (built_ && scene.unit == quantizer_.unit()) {
-            // Keep the trees; store the newest object as insert would have.
-            const ObjectId id = live_.back();
-            const CellBox<D> raw = rawCells(boxes_[id]);
-            if (growFor(raw)) {
-                reclampAll(id);
-            }
-            cells_[id] = clamped(raw);
-            derived().store(id);
-            return;
+            return false;
         }
         quantizer_ = CellQuantizer(scene.unit);
         built_ = true;
@@ -328,13 +526,18 @@ class CellCore {
                 static_cast<Cell>(std::min(quantizer_.cellOf(scene.halfExtent), kCellLimit));
         }
         derived().resetTrees(root);
+        refreshWindows();
         for (ObjectId id : live_) {
             growFor(rawCells(boxes_[id]));
         }
         for (ObjectId id : live_) {
-            cells_[id] = clamped(rawCells(boxes_[id]));
+            const CellBox<D> raw = rawCells(boxes_[id]);
+            stay_[id] = stayOf(raw);
+            cells_[id] = clamped(raw);
             derived().store(id);
         }
+        keptValid_ = false;
+        return true;
     }
 
     CellTuning tuning_;
@@ -343,9 +546,18 @@ class CellCore {
     std::size_t tunedCount_ = 0;
     std::vector<Box> boxes_;
     std::vector<CellBox<D>> cells_;
+    std::vector<Stay> stay_;
+    CellBox<D> window_;  ///< the trees' windows, see refreshWindows
     std::vector<std::uint32_t> position_;
     std::vector<ObjectId> live_;
     std::vector<double> scratch_;
+
+    bool incremental_;
+    PairSet kept_;
+    bool keptValid_ = false;
+    std::vector<Change> changes_;
+    std::vector<std::uint32_t> changeIndex_;  ///< per id: 1 + its index in changes_, or 0
+    bool changesOverflowed_ = false;
 };
 
 }  // namespace kolize

@@ -46,7 +46,9 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
 
     /// Throws std::invalid_argument for a tree axis outside [0, D).
     explicit RangeTree(const Settings& settings = {})
-        : Base(settings.cells), settings_(settings), treeAxis_(settings.treeAxis) {
+        : Base(settings.cells, settings.incremental),
+          settings_(settings),
+          treeAxis_(settings.treeAxis) {
         if (treeAxis_ < 0 || treeAxis_ >= D) {
             throw std::invalid_argument("kolize: RangeTreeSettings::treeAxis must be in [0, " +
                                         std::to_string(D) + ")");
@@ -58,56 +60,16 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
     template <class Sink>
     void findCandidates(Sink&& candidate) {
         sortMarkedNodes();
-        if (this->size() < 2) {
-            return;
-        }
-        tree_.forEachStab(
-            [&](const Entry& j, Index at) {
-                const std::vector<Entry>& entries = tree_.node(at).entries;
-                for (std::size_t k = windowStart(entries, at, j.otherLo[0]); k < entries.size();
-                     ++k) {
-                    const Entry& e = entries[k];
-                    if (e.otherLo[0] > j.otherHi[0]) {
-                        if (settings_.searchSortedLists) {
-                            break;
-                        }
-                        continue;
-                    }
-                    if (e.otherHi[0] >= j.otherLo[0] && (e.lo < j.lo || e.id < j.id) &&
-                        othersOverlap(e, j, 1)) {
-                        candidate(e.id, j.id);
-                    }
-                }
-            },
-            path_, spine_);
+        this->emitCandidates(candidate);
     }
 
     /// Calls `visit(id)` once for every live object whose cell box overlaps the cells of
     /// `box`.
     template <class Visit>
     void queryBox(const Box& box, Visit&& visit) const {
-        if (this->size() == 0) {
-            return;
+        if (this->size() > 0) {
+            visitCells(this->cellsForQuery(box), visit);
         }
-        const CellBox<D> query = this->queryCells(box);
-        const Entry probe = cellEntry<D>(0, query, treeAxis_);
-        const Cell queryLo = query.lo[treeAxis_];
-        tree_.forEachNodeMeeting(queryLo, query.hi[treeAxis_], [&](Index at) {
-            const auto& node = tree_.node(at);
-            const bool sorted = !isMarked(at);
-            const std::size_t start = sorted ? windowStart(node.entries, at, probe.otherLo[0]) : 0;
-            for (std::size_t k = start; k < node.entries.size(); ++k) {
-                const Entry& e = node.entries[k];
-                if (sorted && settings_.searchSortedLists && e.otherLo[0] > probe.otherHi[0]) {
-                    break;
-                }
-                // Reported from the node holding its first cell inside the query (see
-                // SegmentTreeSet::queryBox).
-                if (node.contains(std::max(e.lo, queryLo)) && othersOverlap(e, probe)) {
-                    visit(e.id);
-                }
-            }
-        });
     }
 
     /// Checks the tree, the entries, and that every node not awaiting a sort is sorted and
@@ -159,6 +121,56 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
     };
 
     bool hasTree(int axis) const { return axis == treeAxis_; }
+
+    /// Stabbing on the tree axis (SegmentTree::forEachStab), reading in each node only the
+    /// window of entries that can overlap on the sorted axis.
+    template <class Sink>
+    void enumerateAll(Sink&& candidate) {
+        sortMarkedNodes();  // a rebuild in emitCandidates may have marked nodes again
+        if (this->size() < 2) {
+            return;
+        }
+        tree_.forEachStab(
+            [&](const Entry& j, Index at) {
+                const std::vector<Entry>& entries = tree_.node(at).entries;
+                for (std::size_t k = windowStart(entries, at, j.otherLo[0]); k < entries.size();
+                     ++k) {
+                    const Entry& e = entries[k];
+                    if (e.otherLo[0] > j.otherHi[0]) {
+                        if (settings_.searchSortedLists) {
+                            break;
+                        }
+                        continue;
+                    }
+                    if (e.otherHi[0] >= j.otherLo[0] && (e.lo < j.lo || e.id < j.id) &&
+                        othersOverlap(e, j, 1)) {
+                        candidate(e.id, j.id);
+                    }
+                }
+            },
+            path_, spine_);
+    }
+
+    template <class Visit>
+    void visitCells(const CellBox<D>& query, Visit&& visit) const {
+        const Entry probe = cellEntry<D>(0, query, treeAxis_);
+        const Cell queryLo = query.lo[treeAxis_];
+        tree_.forEachNodeMeeting(queryLo, query.hi[treeAxis_], [&](Index at) {
+            const auto& node = tree_.node(at);
+            const bool sorted = !isMarked(at);
+            const std::size_t start = sorted ? windowStart(node.entries, at, probe.otherLo[0]) : 0;
+            for (std::size_t k = start; k < node.entries.size(); ++k) {
+                const Entry& e = node.entries[k];
+                if (sorted && settings_.searchSortedLists && e.otherLo[0] > probe.otherHi[0]) {
+                    break;
+                }
+                // Reported from the node holding its first cell inside the query.
+                if (node.contains(std::max(e.lo, queryLo)) && othersOverlap(e, probe)) {
+                    visit(e.id);
+                }
+            }
+        });
+    }
     Tree& treeOf(int) { return tree_; }
     const Tree& treeOf(int) const { return tree_; }
 

@@ -19,6 +19,7 @@
 #include <kolize/broadphase/tree_settings.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -43,14 +44,16 @@ class CellQuantizer {
 
     /// The cell of x; values beyond the limits come back as +-(kCellLimit + 1).
     std::int64_t cellOf(double x) const {
-        const double cell = std::floor(x * inverse_);
-        if (!(cell >= double(-kCellLimit))) {  // also NaN, which callers never pass
+        const double scaled = x * inverse_;
+        if (!(scaled >= double(-kCellLimit))) {  // also NaN, which callers never pass
             return -kCellLimit - 1;
         }
-        if (cell > double(kCellLimit)) {
+        if (scaled >= double(kCellLimit + 1)) {
             return kCellLimit + 1;
         }
-        return static_cast<std::int64_t>(cell);
+        // floor without a libm call (x86-64's baseline has no rounding instruction).
+        const auto truncated = static_cast<std::int64_t>(scaled);
+        return truncated - (scaled < double(truncated) ? 1 : 0);
     }
 
   private:
@@ -141,7 +144,7 @@ inline int levelCovering(std::int64_t lo, std::int64_t hi) {
 ///
 /// `Entry` must have members `ObjectId id` and `Cell lo` (the object's first cell on this
 /// axis); the rest is the caller's. A node's entries are in no particular order unless the
-/// caller orders them (then it calls reindex()).
+/// caller orders them (through reorder()).
 template <class Entry>
 class SegmentTree {
   public:
@@ -165,6 +168,36 @@ class SegmentTree {
         std::uint32_t index;
     };
 
+    /// An object's refs, in left-to-right order of their nodes: the first few inline (a
+    /// typical object has at most four canonical nodes per axis), the rest on the heap.
+    class RefList {
+      public:
+        std::size_t size() const { return count_; }
+        Ref& operator[](std::size_t k) { return k < kLocal ? local_[k] : spill_[k - kLocal]; }
+        const Ref& operator[](std::size_t k) const {
+            return k < kLocal ? local_[k] : spill_[k - kLocal];
+        }
+        void push(const Ref& ref) {
+            if (count_ < kLocal) {
+                local_[count_] = ref;
+            } else {
+                spill_.push_back(ref);
+            }
+            ++count_;
+        }
+        void clear() {
+            count_ = 0;
+            spill_.clear();
+        }
+        std::size_t heapBytes() const { return spill_.capacity() * sizeof(Ref); }
+
+      private:
+        static constexpr std::uint32_t kLocal = 4;
+        std::array<Ref, kLocal> local_{};
+        std::uint32_t count_ = 0;
+        std::vector<Ref> spill_;
+    };
+
     /// Drops every node and entry (keeping their memory) and starts over with a root
     /// covering 2^level cells from `first`.
     void reset(std::int64_t first, int level) {
@@ -175,7 +208,7 @@ class SegmentTree {
         for (Index i = static_cast<Index>(nodes_.size()); i-- > 0;) {
             freeNodes_.push_back(i);
         }
-        for (std::vector<Ref>& refs : refs_) {
+        for (RefList& refs : refs_) {
             refs.clear();
         }
         root_ = allocate(first, level, kNone);
@@ -232,34 +265,55 @@ class SegmentTree {
     /// `touched(node)` is called for each node that loses an entry and stays.
     template <class Touched>
     void remove(ObjectId id, Touched&& touched) {
-        std::vector<Ref>& refs = refs_[id];
-        for (const Ref& ref : refs) {
-            Node& node = nodes_[ref.node];
-            if (ref.index + 1 != node.entries.size()) {
-                node.entries[ref.index] = node.entries.back();
-                refOf(node.entries[ref.index].id, ref.node).index = ref.index;
-            }
-            node.entries.pop_back();
-            if (!pruneUpwards(ref.node)) {
-                touched(ref.node);
+        RefList& refs = refs_[id];
+        for (std::size_t k = 0; k < refs.size(); ++k) {
+            const Index node = refs[k].node;
+            takeOut(refs[k]);
+            if (!pruneUpwards(node)) {
+                touched(node);
             }
         }
         refs.clear();
     }
 
-    /// Calls `edit(entry, node)` for each entry of object `id`.
-    template <class Edit>
-    void editEntries(ObjectId id, Edit&& edit) {
-        for (const Ref& ref : refs_[id]) {
-            edit(nodes_[ref.node].entries[ref.index], ref.node);
+    /// Moves stored object `id` to the cell range [lo, hi] (inside the root), as remove then
+    /// insert would, but descending only from the lowest ancestor of its old first node that
+    /// covers the new range: a small move touches only the bottom of the tree.
+    template <class Touched>
+    void move(ObjectId id, std::int64_t lo, std::int64_t hi, const Entry& entry,
+              Touched&& touched) {
+        RefList& refs = refs_[id];
+        Index start = refs.size() > 0 ? refs[0].node : root_;
+        while (start != root_ && (nodes_[start].first > lo || nodes_[start].last() < hi)) {
+            start = nodes_[start].parent;
+        }
+        // Old nodes are pruned only after the insertion: `start` and the nodes below it
+        // that the new range reuses must survive.
+        oldNodes_.clear();
+        for (std::size_t k = 0; k < refs.size(); ++k) {
+            oldNodes_.push_back(refs[k].node);
+            takeOut(refs[k]);
+        }
+        refs.clear();
+        insertBelow(start, id, lo, hi, entry, touched);
+        for (Index node : oldNodes_) {
+            if (!pruneUpwards(node)) {
+                touched(node);
+            }
         }
     }
 
-    /// The object's entries (empty when it is not stored).
-    const std::vector<Ref>& refsOf(ObjectId id) const {
-        static const std::vector<Ref> none;
-        return id < refs_.size() ? refs_[id] : none;
+    /// Calls `edit(entry, node)` for each entry of object `id`.
+    template <class Edit>
+    void editEntries(ObjectId id, Edit&& edit) {
+        const RefList& refs = refs_[id];
+        for (std::size_t k = 0; k < refs.size(); ++k) {
+            edit(nodes_[refs[k].node].entries[refs[k].index], refs[k].node);
+        }
     }
+
+    /// How many nodes hold entries of object `id` (0 when it is not stored).
+    std::size_t entryCount(ObjectId id) const { return id < refs_.size() ? refs_[id].size() : 0; }
 
     /// Lets the caller reorder a node's entries: `reorder(entries)` may permute them; the
     /// tree then records the new positions.
@@ -302,13 +356,13 @@ class SegmentTree {
 
     std::size_t memoryBytes() const {
         std::size_t bytes = nodes_.capacity() * sizeof(Node) +
-                            freeNodes_.capacity() * sizeof(Index) +
-                            refs_.capacity() * sizeof(std::vector<Ref>);
+                            (freeNodes_.capacity() + oldNodes_.capacity()) * sizeof(Index) +
+                            refs_.capacity() * sizeof(RefList);
         for (const Node& node : nodes_) {
             bytes += node.entries.capacity() * sizeof(Entry);
         }
-        for (const std::vector<Ref>& refs : refs_) {
-            bytes += refs.capacity() * sizeof(Ref);
+        for (const RefList& refs : refs_) {
+            bytes += refs.heapBytes();
         }
         return bytes;
     }
@@ -381,10 +435,12 @@ class SegmentTree {
                 if (entry.id >= refs_.size()) {
                     fail("entry of object " + std::to_string(entry.id) + " without refs");
                 }
-                const std::vector<Ref>& refs = refs_[entry.id];
-                if (std::none_of(refs.begin(), refs.end(), [&](const Ref& ref) {
-                        return ref.node == index && ref.index == i;
-                    })) {
+                const RefList& refs = refs_[entry.id];
+                bool known = false;
+                for (std::size_t k = 0; k < refs.size(); ++k) {
+                    known = known || (refs[k].node == index && refs[k].index == i);
+                }
+                if (!known) {
                     fail("object " + std::to_string(entry.id) + " does not know its entry");
                 }
                 check(entry, index);
@@ -403,19 +459,23 @@ class SegmentTree {
         for (ObjectId id = 0; id < std::max<std::size_t>(objectCount, refs_.size()); ++id) {
             std::int64_t lo = 0, hi = 0;
             const bool stored = ranges(id, lo, hi);
-            const std::vector<Ref>& refs = refsOf(id);
+            static const RefList none;
+            const RefList& refs = id < refs_.size() ? refs_[id] : none;
             if (!stored) {
-                if (!refs.empty()) {
+                if (refs.size() != 0) {
                     fail("object " + std::to_string(id) + " not stored but has entries");
                 }
                 continue;
             }
             // The canonical nodes tile [lo, hi] exactly.
             std::int64_t cells = 0;
-            for (const Ref& ref : refs) {
-                cells += std::int64_t(1) << nodes_[ref.node].level;
+            for (std::size_t k = 0; k < refs.size(); ++k) {
+                cells += std::int64_t(1) << nodes_[refs[k].node].level;
+                if (k > 0 && nodes_[refs[k].node].first <= nodes_[refs[k - 1].node].first) {
+                    fail("object " + std::to_string(id) + " refs out of order");
+                }
             }
-            if (refs.empty() || cells != hi - lo + 1) {
+            if (refs.size() == 0 || cells != hi - lo + 1) {
                 fail("object " + std::to_string(id) + " entries do not tile its range");
             }
             refCount += refs.size();
@@ -448,12 +508,23 @@ class SegmentTree {
     }
 
     Ref& refOf(ObjectId id, Index node) {
-        for (Ref& ref : refs_[id]) {
-            if (ref.node == node) {
-                return ref;
+        RefList& refs = refs_[id];
+        for (std::size_t k = 0; k < refs.size(); ++k) {
+            if (refs[k].node == node) {
+                return refs[k];
             }
         }
         throw std::logic_error("SegmentTree: entry without a ref");
+    }
+
+    /// Removes the entry at `ref` by moving the node's last entry into its place.
+    void takeOut(const Ref& ref) {
+        Node& node = nodes_[ref.node];
+        if (ref.index + 1 != node.entries.size()) {
+            node.entries[ref.index] = node.entries.back();
+            refOf(node.entries[ref.index].id, ref.node).index = ref.index;
+        }
+        node.entries.pop_back();
     }
 
     template <class Touched>
@@ -463,7 +534,7 @@ class SegmentTree {
         const std::int64_t last = nodes_[index].last();
         if (lo <= first && hi >= last) {
             Node& node = nodes_[index];
-            refs_[id].push_back(Ref{index, static_cast<std::uint32_t>(node.entries.size())});
+            refs_[id].push(Ref{index, static_cast<std::uint32_t>(node.entries.size())});
             node.entries.push_back(entry);
             touched(index);
             return;
@@ -559,7 +630,8 @@ class SegmentTree {
 
     std::vector<Node> nodes_;
     std::vector<Index> freeNodes_;
-    std::vector<std::vector<Ref>> refs_;
+    std::vector<RefList> refs_;
+    std::vector<Index> oldNodes_;
     Index root_ = kNone;
 };
 

@@ -5,29 +5,44 @@
 ///
 /// Candidates are the pairs whose cell boxes overlap on every axis: a superset of the
 /// pairs whose boxes overlap (quantisation only adds), which the adapter's exact test
-/// reduces to exactly those. Two traversals return that same set:
+/// reduces to exactly those. Three ways give that same set:
 /// - Traversal::Stabbing (default): on one axis, every object looks up the objects whose
-///   range contains its first cell — one root-to-leaf path (SegmentTree::forEachStab) — and
-///   tests their other axes from the entries, which carry them. Each pair is met once, with
-///   no flags. The axis is the one with the least stabbing work, re-chosen every 32 frames.
+///   range contains its first cell — one root-to-leaf path — and tests their other axes.
+///   Each pair is met once, with no flags. The axis is the one with the least stabbing
+///   work, re-chosen every 32 frames. The path's entries are laid out flat, field by field,
+///   so the tests run four entries at a time.
 /// - Traversal::ThesisFlags: the thesis's walk. For every object and every axis, all nodes
 ///   meeting its range are visited and their objects flagged for that axis; objects
 ///   flagged on all axes are candidates. Visits every 1-D overlap on every axis.
+/// - incremental (with Stabbing, on by default): the set of the last frame is kept and
+///   updated from the objects whose cell box changed (see CellCore), which is most frames
+///   when motion is slow relative to the leaf width.
 ///
-/// Unbounded (see CellCore): trees grow to cover any object within +-kCellLimit cells of
-/// the origin, so nothing is ever dropped; a +-1e18 plane is clamped to the root's range and
-/// sits in the root, a candidate with everything, which is what it is.
+/// Updates: an object whose cell box keeps its place costs a quantisation; one that changes
+/// range on an axis is moved in that axis's tree from the lowest node covering its new
+/// range. Unbounded (see CellCore): trees grow to cover any object within +-kCellLimit cells
+/// of the origin, so nothing is ever dropped; a +-1e18 plane is clamped to the root's range
+/// and sits in the root, a candidate with everything, which is what it is.
 
 #include <kolize/broadphase/aabb.h>
 #include <kolize/broadphase/cell_core.h>
 #include <kolize/broadphase/segment_tree.h>
+#include <kolize/broadphase/tree_settings.h>
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
 namespace kolize {
+
+/// A segment-tree-set entry: the object and its first cell on the tree's axis (which tells
+/// whether this node is the object's first).
+struct SegmentEntry {
+    ObjectId id = 0;
+    Cell lo = 0;
+};
 
 template <int D, class Scalar>
 class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
@@ -37,66 +52,29 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
   public:
     using Box = Aabb<D, Scalar>;
     using Settings = SegmentTreeSettings;
-    using Entry = CellEntry<D>;
+    using Entry = SegmentEntry;
     using Tree = SegmentTree<Entry>;
     using Index = typename Tree::Index;
 
     explicit SegmentTreeSet(const Settings& settings = {})
-        : Base(settings.cells), settings_(settings) {}
+        : Base(settings.cells,
+               settings.incremental && settings.traversal == Settings::Traversal::Stabbing),
+          settings_(settings) {}
 
     /// Calls `candidate(a, b)` once for every unordered pair of live objects whose cell
     /// boxes overlap on all axes.
     template <class Sink>
     void findCandidates(Sink&& candidate) {
-        if (this->size() < 2) {
-            return;
-        }
-        if (settings_.traversal == Settings::Traversal::ThesisFlags) {
-            flagWalk(candidate);
-            return;
-        }
-        if (frame_++ % kAxisReviewFrames == 0) {
-            chooseAxis();
-        }
-        const Tree& tree = trees_[axis_];
-        tree.forEachStab(
-            [&](const Entry& j, Index at) {
-                for (const Entry& e : tree.node(at).entries) {
-                    if ((e.lo < j.lo || e.id < j.id) && othersOverlap(e, j)) {
-                        candidate(e.id, j.id);
-                    }
-                }
-            },
-            path_, spine_);
+        this->emitCandidates(candidate);
     }
 
     /// Calls `visit(id)` once for every live object whose cell box overlaps the cells of
     /// `box`. Walks one tree, on the axis where the query is narrowest.
     template <class Visit>
     void queryBox(const Box& box, Visit&& visit) const {
-        if (this->size() == 0) {
-            return;
+        if (this->size() > 0) {
+            visitCells(this->cellsForQuery(box), visit);
         }
-        const CellBox<D> query = this->queryCells(box);
-        int axis = 0;
-        for (int a = 1; a < D; ++a) {
-            if (std::int64_t(query.hi[a]) - query.lo[a] <
-                std::int64_t(query.hi[axis]) - query.lo[axis]) {
-                axis = a;
-            }
-        }
-        const Entry probe = cellEntry<D>(0, query, axis);
-        const Tree& tree = trees_[axis];
-        tree.forEachNodeMeeting(query.lo[axis], query.hi[axis], [&](Index at) {
-            const auto& node = tree.node(at);
-            for (const Entry& e : node.entries) {
-                // An object meets the query in several of its nodes; report it from the one
-                // holding its first cell inside the query.
-                if (node.contains(std::max(e.lo, query.lo[axis])) && othersOverlap(e, probe)) {
-                    visit(e.id);
-                }
-            }
-        });
     }
 
     /// Checks every tree against the objects' cell boxes; throws std::logic_error.
@@ -106,15 +84,9 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
             return;
         }
         for (int axis = 0; axis < D; ++axis) {
-            trees_[axis].validate(
-                "SegmentTreeSet axis " + std::to_string(axis), this->live().size(),
-                this->storedRangeOn(axis), [&](const Entry& e, Index) {
-                    const Entry expected = cellEntry<D>(e.id, this->cells(e.id), axis);
-                    if (expected.otherLo != e.otherLo || expected.otherHi != e.otherHi) {
-                        throw std::logic_error("SegmentTreeSet axis " + std::to_string(axis) +
-                                               ": stale entry of object " + std::to_string(e.id));
-                    }
-                });
+            trees_[axis].validate("SegmentTreeSet axis " + std::to_string(axis),
+                                  this->live().size(), this->storedRangeOn(axis),
+                                  [](const Entry&, Index) {});
         }
     }
 
@@ -122,7 +94,7 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     std::size_t memoryBytes() const {
         std::size_t bytes = this->objectMemoryBytes() +
                             (stampOf_.capacity() * sizeof(std::uint32_t)) + flags_.capacity() +
-                            (path_.capacity() + spine_.capacity()) * sizeof(Index);
+                            flat_.capacity() * sizeof(Cell) + path_.capacity() * sizeof(Span);
         for (const Tree& tree : trees_) {
             bytes += tree.memoryBytes();
         }
@@ -139,13 +111,23 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     }
 
     /// Nodes holding object `id`'s entries on `axis` (its canonical decomposition).
-    std::size_t nodesOf(ObjectId id, int axis) const { return trees_[axis].refsOf(id).size(); }
+    std::size_t nodesOf(ObjectId id, int axis) const { return trees_[axis].entryCount(id); }
 
     /// The axis the stabbing traversal uses now.
     int stabbingAxis() const { return axis_; }
 
   private:
     static constexpr unsigned kAxisReviewFrames = 32;
+    /// Fields of the flat layout: id, first cell on the stabbing axis, then lo and hi on
+    /// each other axis.
+    static constexpr int kFields = 2 + 2 * (D - 1);
+
+    /// A node's entries in the flat layout: its first entries in [begin, firstEnd), the
+    /// others in [firstEnd, end).
+    struct Span {
+        std::uint32_t begin, firstEnd, end;
+        std::int64_t first;
+    };
 
     bool hasTree(int) const { return true; }
     Tree& treeOf(int axis) { return trees_[axis]; }
@@ -159,15 +141,11 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     }
 
     void store(ObjectId id) {
-        for (int axis = 0; axis < D; ++axis) {
-            storeOn(axis, id);
-        }
-    }
-
-    void storeOn(int axis, ObjectId id) {
         const CellBox<D>& cells = this->cells(id);
-        trees_[axis].insert(id, cells.lo[axis], cells.hi[axis], cellEntry<D>(id, cells, axis),
-                            [](Index) {});
+        for (int axis = 0; axis < D; ++axis) {
+            trees_[axis].insert(id, cells.lo[axis], cells.hi[axis], Entry{id, cells.lo[axis]},
+                                [](Index) {});
+        }
     }
 
     void unstore(ObjectId id) {
@@ -180,14 +158,188 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         const CellBox<D>& cells = this->cells(id);
         for (int axis = 0; axis < D; ++axis) {
             if (cells.lo[axis] != old.lo[axis] || cells.hi[axis] != old.hi[axis]) {
-                trees_[axis].remove(id, [](Index) {});
-                storeOn(axis, id);
-            } else {
-                // Same nodes; refresh the other axes the entries carry.
-                const Entry fresh = cellEntry<D>(id, cells, axis);
-                trees_[axis].editEntries(id, [&](Entry& e, Index) { e = fresh; });
+                trees_[axis].move(id, cells.lo[axis], cells.hi[axis], Entry{id, cells.lo[axis]},
+                                  [](Index) {});
             }
         }
+    }
+
+    template <class Visit>
+    void visitCells(const CellBox<D>& query, Visit&& visit) const {
+        int axis = 0;
+        for (int a = 1; a < D; ++a) {
+            if (std::int64_t(query.hi[a]) - query.lo[a] <
+                std::int64_t(query.hi[axis]) - query.lo[axis]) {
+                axis = a;
+            }
+        }
+        const Tree& tree = trees_[axis];
+        tree.forEachNodeMeeting(query.lo[axis], query.hi[axis], [&](Index at) {
+            const auto& node = tree.node(at);
+            for (const Entry& e : node.entries) {
+                // An object meets the query in several of its nodes; report it from the one
+                // holding its first cell inside the query.
+                if (node.contains(std::max(e.lo, query.lo[axis])) &&
+                    cellsOverlap(this->cells(e.id), query)) {
+                    visit(e.id);
+                }
+            }
+        });
+    }
+
+    template <class Sink>
+    void enumerateAll(Sink&& candidate) {
+        if (this->size() < 2) {
+            return;
+        }
+        if (settings_.traversal == Settings::Traversal::ThesisFlags) {
+            flagWalk(candidate);
+            return;
+        }
+        if (frame_++ % kAxisReviewFrames == 0) {
+            chooseAxis();
+        }
+        flatCount_ = 0;
+        path_.clear();
+        stabBelow(trees_[axis_].root(), candidate);
+    }
+
+    /// Stabbing in tree order. At each node: its first entries against every node on the
+    /// path (itself included), and the first entries of the ancestors that start at the
+    /// same cell (this node is on their left spine, so on their stabbing paths) against
+    /// this node. Together: each entry j against exactly the nodes containing j.lo.
+    template <class Sink>
+    void stabBelow(Index at, Sink& candidate) {
+        const auto& node = trees_[axis_].node(at);
+        const bool stored = !node.entries.empty();
+        if (stored) {
+            Span span;
+            span.first = node.first;
+            span.begin = static_cast<std::uint32_t>(flatSize());
+            for (const Entry& e : node.entries) {
+                if (e.lo == node.first) {
+                    append(e);
+                }
+            }
+            span.firstEnd = static_cast<std::uint32_t>(flatSize());
+            for (const Entry& e : node.entries) {
+                if (e.lo != node.first) {
+                    append(e);
+                }
+            }
+            span.end = static_cast<std::uint32_t>(flatSize());
+            path_.push_back(span);
+            for (std::uint32_t j = span.begin; j < span.firstEnd; ++j) {
+                for (const Span& up : path_) {
+                    scan(j, up.begin, up.end, candidate);
+                }
+            }
+            for (std::size_t k = path_.size() - 1; k-- > 0 && path_[k].first == node.first;) {
+                for (std::uint32_t j = path_[k].begin; j < path_[k].firstEnd; ++j) {
+                    scan(j, span.begin, span.end, candidate);
+                }
+            }
+        }
+        for (Index child : node.child) {
+            if (child != Tree::kNone) {
+                stabBelow(child, candidate);
+            }
+        }
+        if (stored) {
+            path_.pop_back();
+            // The flat entries of this subtree are no longer on any path.
+            resizeFlat(path_.empty() ? 0 : path_.back().end);
+        }
+    }
+
+    std::size_t flatSize() const { return flatCount_; }
+
+    void resizeFlat(std::size_t entries) { flatCount_ = entries; }
+
+    /// Appends an entry to the flat layout: fields interleaved in blocks of four entries,
+    /// so that each field of four consecutive entries is one vector load.
+    void append(const Entry& e) {
+        const std::size_t index = flatCount_++;
+        const std::size_t blockStart = (index / 4) * 4 * kFields;
+        if (blockStart + 4 * kFields > flat_.size()) {
+            flat_.resize(blockStart + 4 * kFields);
+        }
+        Cell* block = &flat_[blockStart];
+        const std::size_t lane = index % 4;
+        const CellBox<D>& cells = this->cells(e.id);
+        block[0 * 4 + lane] = static_cast<Cell>(e.id);
+        block[1 * 4 + lane] = e.lo;
+        for (int k = 0; k < D - 1; ++k) {
+            block[(2 + 2 * k) * 4 + lane] = cells.lo[otherAxis(axis_, k)];
+            block[(3 + 2 * k) * 4 + lane] = cells.hi[otherAxis(axis_, k)];
+        }
+    }
+
+    Cell field(std::uint32_t index, int f) const {
+        return flat_[(index / 4) * 4 * kFields + std::size_t(f) * 4 + index % 4];
+    }
+
+    /// Tests entry j (stabbing) against entries [begin, end): reports e when its range
+    /// starts before j's (or at the same cell with a smaller id) and it overlaps j on the
+    /// other axes.
+    template <class Sink>
+    void scan(std::uint32_t j, std::uint32_t begin, std::uint32_t end, Sink& candidate) const {
+        Cell probe[kFields];
+        for (int f = 0; f < kFields; ++f) {
+            probe[f] = field(j, f);
+        }
+        std::uint32_t k = begin;
+        // Scalar up to a block boundary, four at a time through whole blocks, scalar tail.
+        for (; k < end && k % 4 != 0; ++k) {
+            scanOne(k, probe, candidate);
+        }
+        for (; k + 4 <= end; k += 4) {
+            const Cell* block = &flat_[(k / 4) * 4 * kFields];
+            if (anyMatch(block, probe)) {
+                for (std::uint32_t lane = 0; lane < 4; ++lane) {
+                    scanOne(k + lane, probe, candidate);
+                }
+            }
+        }
+        for (; k < end; ++k) {
+            scanOne(k, probe, candidate);
+        }
+    }
+
+    template <class Sink>
+    void scanOne(std::uint32_t k, const Cell* probe, Sink& candidate) const {
+        const Cell id = field(k, 0), lo = field(k, 1);
+        if (!(lo < probe[1] || id < probe[0])) {
+            return;
+        }
+        for (int f = 2; f < kFields; f += 2) {
+            if (field(k, f) > probe[f + 1] || field(k, f + 1) < probe[f]) {
+                return;
+            }
+        }
+        candidate(ObjectId(id), ObjectId(probe[0]));
+    }
+
+    /// Four cells, one per lane (GCC / Clang vector extension: SSE2 on x86-64, NEON on
+    /// ARM, plain code elsewhere).
+    using Lanes = std::int32_t __attribute__((vector_size(16)));
+
+    static Lanes lanes(const Cell* cells) {
+        Lanes out;
+        std::memcpy(&out, cells, sizeof out);
+        return out;
+    }
+    static Lanes broadcast(Cell cell) { return Lanes{cell, cell, cell, cell}; }
+
+    /// Whether any of the four entries of `block` passes scanOne's test, branch-free.
+    static bool anyMatch(const Cell* block, const Cell* probe) {
+        Lanes match =
+            (lanes(block + 4) < broadcast(probe[1])) | (lanes(block) < broadcast(probe[0]));
+        for (int f = 2; f < kFields; f += 2) {
+            match &= (lanes(block + f * 4) <= broadcast(probe[f + 1])) &
+                     (lanes(block + (f + 1) * 4) >= broadcast(probe[f]));
+        }
+        return (match[0] | match[1] | match[2] | match[3]) != 0;
     }
 
     /// Picks the axis with the least stabbing work: the sum over nodes of entries x first
@@ -262,7 +414,9 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     std::array<Tree, D> trees_;
     int axis_ = 0;
     unsigned frame_ = 0;
-    std::vector<Index> path_, spine_;
+    std::vector<Cell> flat_;
+    std::size_t flatCount_ = 0;
+    std::vector<Span> path_;
     std::vector<std::uint32_t> stampOf_;
     std::vector<std::uint8_t> flags_;
     std::uint32_t stamp_ = 0;

@@ -29,6 +29,10 @@ struct SegmentTreeSettings {
     };
     /// How candidate pairs are found; both give the same set.
     Traversal traversal = Traversal::Stabbing;
+    /// With Stabbing: keep the candidate set between frames and update it from the objects
+    /// whose cell box changed, while few did (default). false: enumerate every frame.
+    /// Same set either way.
+    bool incremental = true;
 };
 
 /// Settings of RangeTree (broadphase "range-tree").
@@ -42,6 +46,9 @@ struct RangeTreeSettings {
     /// false: scans the lists whole, as a segment tree would; for measuring what the
     /// sorting buys. Both give the same candidates.
     bool searchSortedLists = true;
+    /// Keep the candidate set between frames and update it from the objects whose cell box
+    /// changed, while few did (default). false: enumerate every frame. Same set either way.
+    bool incremental = true;
 };
 
 }  // namespace kolize
