@@ -41,15 +41,23 @@ struct CellBox {
 };
 
 /// An entry of a segment-tree node: the object, its first cell on the tree's axis (which
-/// tells whether this node is the object's first), and its cell range on the other axes in
-/// increasing axis order, so candidate tests need no lookup outside the node.
+/// tells whether this node is the object's first), and its cell ranges on the other axes in
+/// increasing axis order, so candidate tests need no lookup outside the node. The ranges are
+/// kept as (lo..., -hi...): an entry overlaps a box on those axes exactly when every value
+/// is <= the box's reach (hi..., -lo...), one comparison of 2(D-1) lanes.
 template <int D>
 struct CellEntry {
     ObjectId id = 0;
     Cell lo = 0;
-    std::array<Cell, D - 1> otherLo{};
-    std::array<Cell, D - 1> otherHi{};
+    std::array<Cell, 2 * (D - 1)> other{};
+
+    Cell otherLo(int k) const { return other[k]; }
+    Cell otherHi(int k) const { return -other[D - 1 + k]; }
 };
+
+/// (hi..., -lo...) of a range on the other axes; see CellEntry.
+template <int D>
+using Reach = std::array<Cell, 2 * (D - 1)>;
 
 /// The k-th axis other than `axis`.
 constexpr int otherAxis(int axis, int k) {
@@ -63,21 +71,31 @@ CellEntry<D> cellEntry(ObjectId id, const CellBox<D>& cells, int axis) {
     entry.id = id;
     entry.lo = cells.lo[axis];
     for (int k = 0; k < D - 1; ++k) {
-        entry.otherLo[k] = cells.lo[otherAxis(axis, k)];
-        entry.otherHi[k] = cells.hi[otherAxis(axis, k)];
+        entry.other[k] = cells.lo[otherAxis(axis, k)];
+        entry.other[D - 1 + k] = -cells.hi[otherAxis(axis, k)];
     }
     return entry;
 }
 
-/// Whether entries a and b overlap on the axes other than their tree's, from `from` on.
+/// The reach of an entry's other-axis ranges.
 template <int D>
-inline bool othersOverlap(const CellEntry<D>& a, const CellEntry<D>& b, int from = 0) {
-    for (int k = from; k < D - 1; ++k) {
-        if (a.otherLo[k] > b.otherHi[k] || b.otherLo[k] > a.otherHi[k]) {
-            return false;
-        }
+Reach<D> reachOf(const CellEntry<D>& e) {
+    Reach<D> reach;
+    for (int k = 0; k < D - 1; ++k) {
+        reach[k] = e.otherHi(k);
+        reach[D - 1 + k] = -e.otherLo(k);
     }
-    return true;
+    return reach;
+}
+
+/// Whether entry e overlaps, on the axes other than its tree's, the ranges with `reach`.
+template <int D>
+inline bool othersOverlap(const CellEntry<D>& e, const Reach<D>& reach) {
+    bool inside = true;
+    for (int i = 0; i < 2 * (D - 1); ++i) {
+        inside &= e.other[i] <= reach[i];
+    }
+    return inside;
 }
 
 /// Whether two cell boxes overlap on every axis.
@@ -130,6 +148,7 @@ class CellCore {
             boxes_.resize(id + 1);
             cells_.resize(id + 1);
             stay_.resize(id + 1);
+            changeIndex_.resize(id + 1, 0);
             position_.resize(id + 1, kAbsent);
         }
         boxes_[id] = box;
@@ -164,6 +183,7 @@ class CellCore {
     /// Removes live object `id`.
     void remove(ObjectId id) {
         derived().unstore(id);
+        noteRemoval(id);
         const std::uint32_t at = position_[id];
         const ObjectId last = live_.back();
         live_[at] = last;
@@ -220,7 +240,9 @@ class CellCore {
             }
             kept_.retainIf([&](PairSet::Entry& entry) {
                 const ObjectId a = entry.first(), b = entry.second();
-                if (!isLive(a) || !isLive(b) || !cellsOverlap(cells_[a], cells_[b])) {
+                // A pair of objects that neither changed cells nor went away still overlaps.
+                const bool touched = changeIndex_[a] != 0 || changeIndex_[b] != 0;
+                if (touched && (!isLive(a) || !isLive(b) || !cellsOverlap(cells_[a], cells_[b]))) {
                     return false;
                 }
                 candidate(a, b);
@@ -243,7 +265,11 @@ class CellCore {
         for (const Change& change : changes_) {
             changeIndex_[change.id] = 0;
         }
+        for (ObjectId id : removed_) {
+            changeIndex_[id] = 0;
+        }
         changes_.clear();
+        removed_.clear();
         changesOverflowed_ = false;
     }
 
@@ -321,7 +347,7 @@ class CellCore {
                (position_.capacity() + live_.capacity() + changeIndex_.capacity()) *
                    sizeof(std::uint32_t) +
                scratch_.capacity() * sizeof(double) + kept_.memoryBytes() +
-               changes_.capacity() * sizeof(Change);
+               changes_.capacity() * sizeof(Change) + removed_.capacity() * sizeof(ObjectId);
     }
 
     const std::vector<ObjectId>& live() const { return live_; }
@@ -334,6 +360,8 @@ class CellCore {
     /// everything without keeping it (fast motion: keeping would not pay).
     static constexpr std::size_t kIncrementalShare = 4;
     static constexpr std::size_t kKeepShare = 2;
+    /// changeIndex_ of an object removed (and not re-inserted) since the last frame.
+    static constexpr std::uint32_t kRemovedMark = 0xffffffffu;
 
     /// An object whose cell box changed since the last frame: its box then (`old`), or
     /// `inserted` when it was not there.
@@ -347,10 +375,7 @@ class CellCore {
         if (!incremental_ || changesOverflowed_) {
             return;
         }
-        if (id >= changeIndex_.size()) {
-            changeIndex_.resize(id + 1, 0);
-        }
-        if (changeIndex_[id] != 0) {
+        if (changeIndex_[id] != 0 && changeIndex_[id] != kRemovedMark) {
             changes_[changeIndex_[id] - 1].inserted |= old == nullptr;
             return;
         }
@@ -360,6 +385,15 @@ class CellCore {
         }
         changes_.push_back(Change{id, old == nullptr, old != nullptr ? *old : CellBox<D>{}});
         changeIndex_[id] = static_cast<std::uint32_t>(changes_.size());
+    }
+
+    /// Marks a removed object, so that the kept set checks its pairs.
+    void noteRemoval(ObjectId id) {
+        if (!incremental_ || changesOverflowed_ || changeIndex_[id] != 0) {
+            return;
+        }
+        changeIndex_[id] = kRemovedMark;
+        removed_.push_back(id);
     }
 
     /// Adds to the kept set the pairs of `change.id` whose cells overlap its grown part.
@@ -556,7 +590,9 @@ class CellCore {
     PairSet kept_;
     bool keptValid_ = false;
     std::vector<Change> changes_;
-    std::vector<std::uint32_t> changeIndex_;  ///< per id: 1 + its index in changes_, or 0
+    /// Per id: 1 + its index in changes_, kRemovedMark, or 0 when untouched this frame.
+    std::vector<std::uint32_t> changeIndex_;
+    std::vector<ObjectId> removed_;
     bool changesOverflowed_ = false;
 };
 

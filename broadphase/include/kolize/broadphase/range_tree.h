@@ -83,7 +83,7 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
             "RangeTree", this->live().size(), this->storedRangeOn(treeAxis_),
             [&](const Entry& e, Index at) {
                 const Entry expected = cellEntry<D>(e.id, this->cells(e.id), treeAxis_);
-                if (expected.otherLo != e.otherLo || expected.otherHi != e.otherHi) {
+                if (expected.other != e.other) {
                     throw std::logic_error("RangeTree: stale entry of object " +
                                            std::to_string(e.id));
                 }
@@ -92,10 +92,10 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
                 }
                 const std::vector<Entry>& entries = tree_.node(at).entries;
                 const std::size_t k = std::size_t(&e - entries.data());
-                if (k > 0 && entries[k - 1].otherLo[0] > e.otherLo[0]) {
+                if (k > 0 && entries[k - 1].otherLo(0) > e.otherLo(0)) {
                     throw std::logic_error("RangeTree: node " + std::to_string(at) + " not sorted");
                 }
-                if (std::int64_t(e.otherHi[0]) - e.otherLo[0] > order_[at].widest) {
+                if (std::int64_t(e.otherHi(0)) - e.otherLo(0) > order_[at].widest) {
                     throw std::logic_error("RangeTree: node " + std::to_string(at) +
                                            " underestimates its widest entry");
                 }
@@ -133,17 +133,17 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         tree_.forEachStab(
             [&](const Entry& j, Index at) {
                 const std::vector<Entry>& entries = tree_.node(at).entries;
-                for (std::size_t k = windowStart(entries, at, j.otherLo[0]); k < entries.size();
+                const Reach<D> reach = reachOf(j);
+                for (std::size_t k = windowStart(entries, at, j.otherLo(0)); k < entries.size();
                      ++k) {
                     const Entry& e = entries[k];
-                    if (e.otherLo[0] > j.otherHi[0]) {
+                    if (e.otherLo(0) > j.otherHi(0)) {
                         if (settings_.searchSortedLists) {
                             break;
                         }
                         continue;
                     }
-                    if (e.otherHi[0] >= j.otherLo[0] && (e.lo < j.lo || e.id < j.id) &&
-                        othersOverlap(e, j, 1)) {
+                    if (othersOverlap(e, reach) && (e.lo < j.lo || e.id < j.id)) {
                         candidate(e.id, j.id);
                     }
                 }
@@ -154,18 +154,19 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
     template <class Visit>
     void visitCells(const CellBox<D>& query, Visit&& visit) const {
         const Entry probe = cellEntry<D>(0, query, treeAxis_);
+        const Reach<D> reach = reachOf(probe);
         const Cell queryLo = query.lo[treeAxis_];
         tree_.forEachNodeMeeting(queryLo, query.hi[treeAxis_], [&](Index at) {
             const auto& node = tree_.node(at);
             const bool sorted = !isMarked(at);
-            const std::size_t start = sorted ? windowStart(node.entries, at, probe.otherLo[0]) : 0;
+            const std::size_t start = sorted ? windowStart(node.entries, at, probe.otherLo(0)) : 0;
             for (std::size_t k = start; k < node.entries.size(); ++k) {
                 const Entry& e = node.entries[k];
-                if (sorted && settings_.searchSortedLists && e.otherLo[0] > probe.otherHi[0]) {
+                if (sorted && settings_.searchSortedLists && e.otherLo(0) > probe.otherHi(0)) {
                     break;
                 }
                 // Reported from the node holding its first cell inside the query.
-                if (node.contains(std::max(e.lo, queryLo)) && othersOverlap(e, probe)) {
+                if (othersOverlap(e, reach) && node.contains(std::max(e.lo, queryLo))) {
                     visit(e.id);
                 }
             }
@@ -195,7 +196,7 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         const std::int64_t from = std::int64_t(lo) - order_[at].widest;
         return std::size_t(std::partition_point(
                                entries.begin(), entries.end(),
-                               [&](const Entry& e) { return std::int64_t(e.otherLo[0]) < from; }) -
+                               [&](const Entry& e) { return std::int64_t(e.otherLo(0)) < from; }) -
                            entries.begin());
     }
 
@@ -225,7 +226,7 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         const Entry fresh = cellEntry<D>(id, cells, treeAxis_);
         const int sortedAxis = otherAxis(treeAxis_, 0);
         const bool keyMoved = cells.lo[sortedAxis] != old.lo[sortedAxis];
-        const std::int64_t width = std::int64_t(fresh.otherHi[0]) - fresh.otherLo[0];
+        const std::int64_t width = std::int64_t(fresh.otherHi(0)) - fresh.otherLo(0);
         tree_.editEntries(id, [&](Entry& e, Index at) {
             e = fresh;
             if (keyMoved) {
@@ -246,7 +247,7 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
             tree_.reorder(at, [&](std::vector<Entry>& entries) {
                 sortByFirstCell(entries);
                 for (const Entry& e : entries) {
-                    widest = std::max(widest, std::int64_t(e.otherHi[0]) - e.otherLo[0]);
+                    widest = std::max(widest, std::int64_t(e.otherHi(0)) - e.otherLo(0));
                 }
             });
             order_[at].widest = widest;
@@ -258,12 +259,12 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         const std::size_t budget = 4 * entries.size() + 16;
         std::size_t shifts = 0;
         for (std::size_t i = 1; i < entries.size(); ++i) {
-            if (entries[i - 1].otherLo[0] <= entries[i].otherLo[0]) {
+            if (entries[i - 1].otherLo(0) <= entries[i].otherLo(0)) {
                 continue;
             }
             const Entry moving = entries[i];
             std::size_t k = i;
-            while (k > 0 && entries[k - 1].otherLo[0] > moving.otherLo[0]) {
+            while (k > 0 && entries[k - 1].otherLo(0) > moving.otherLo(0)) {
                 entries[k] = entries[k - 1];
                 --k;
             }
@@ -271,7 +272,7 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
             shifts += i - k;
             if (shifts > budget) {
                 std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-                    return a.otherLo[0] < b.otherLo[0];
+                    return a.otherLo(0) < b.otherLo(0);
                 });
                 return;
             }

@@ -32,17 +32,11 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace kolize {
-
-/// A segment-tree-set entry: the object and its first cell on the tree's axis (which tells
-/// whether this node is the object's first).
-struct SegmentEntry {
-    ObjectId id = 0;
-    Cell lo = 0;
-};
 
 template <int D, class Scalar>
 class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
@@ -52,7 +46,7 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
   public:
     using Box = Aabb<D, Scalar>;
     using Settings = SegmentTreeSettings;
-    using Entry = SegmentEntry;
+    using Entry = CellEntry<D>;
     using Tree = SegmentTree<Entry>;
     using Index = typename Tree::Index;
 
@@ -84,9 +78,15 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
             return;
         }
         for (int axis = 0; axis < D; ++axis) {
-            trees_[axis].validate("SegmentTreeSet axis " + std::to_string(axis),
-                                  this->live().size(), this->storedRangeOn(axis),
-                                  [](const Entry&, Index) {});
+            trees_[axis].validate(
+                "SegmentTreeSet axis " + std::to_string(axis), this->live().size(),
+                this->storedRangeOn(axis), [&](const Entry& e, Index) {
+                    const Entry expected = cellEntry<D>(e.id, this->cells(e.id), axis);
+                    if (expected.other != e.other) {
+                        throw std::logic_error("SegmentTreeSet axis " + std::to_string(axis) +
+                                               ": stale entry of object " + std::to_string(e.id));
+                    }
+                });
         }
     }
 
@@ -118,8 +118,8 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
 
   private:
     static constexpr unsigned kAxisReviewFrames = 32;
-    /// Fields of the flat layout: id, first cell on the stabbing axis, then lo and hi on
-    /// each other axis.
+    /// Fields of the flat layout: id, first cell on the stabbing axis, then the entry's
+    /// other-axis values (lo..., -hi...).
     static constexpr int kFields = 2 + 2 * (D - 1);
 
     /// A node's entries in the flat layout: its first entries in [begin, firstEnd), the
@@ -143,7 +143,7 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     void store(ObjectId id) {
         const CellBox<D>& cells = this->cells(id);
         for (int axis = 0; axis < D; ++axis) {
-            trees_[axis].insert(id, cells.lo[axis], cells.hi[axis], Entry{id, cells.lo[axis]},
+            trees_[axis].insert(id, cells.lo[axis], cells.hi[axis], cellEntry<D>(id, cells, axis),
                                 [](Index) {});
         }
     }
@@ -157,9 +157,12 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     void restore(ObjectId id, const CellBox<D>& old) {
         const CellBox<D>& cells = this->cells(id);
         for (int axis = 0; axis < D; ++axis) {
+            const Entry fresh = cellEntry<D>(id, cells, axis);
             if (cells.lo[axis] != old.lo[axis] || cells.hi[axis] != old.hi[axis]) {
-                trees_[axis].move(id, cells.lo[axis], cells.hi[axis], Entry{id, cells.lo[axis]},
-                                  [](Index) {});
+                trees_[axis].move(id, cells.lo[axis], cells.hi[axis], fresh, [](Index) {});
+            } else {
+                // Same nodes; refresh the other axes the entries carry.
+                trees_[axis].editEntries(id, [&](Entry& e, Index) { e = fresh; });
             }
         }
     }
@@ -174,13 +177,13 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
             }
         }
         const Tree& tree = trees_[axis];
+        const Reach<D> reach = reachOf(cellEntry<D>(0, query, axis));
         tree.forEachNodeMeeting(query.lo[axis], query.hi[axis], [&](Index at) {
             const auto& node = tree.node(at);
             for (const Entry& e : node.entries) {
                 // An object meets the query in several of its nodes; report it from the one
                 // holding its first cell inside the query.
-                if (node.contains(std::max(e.lo, query.lo[axis])) &&
-                    cellsOverlap(this->cells(e.id), query)) {
+                if (othersOverlap(e, reach) && node.contains(std::max(e.lo, query.lo[axis]))) {
                     visit(e.id);
                 }
             }
@@ -266,12 +269,10 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         }
         Cell* block = &flat_[blockStart];
         const std::size_t lane = index % 4;
-        const CellBox<D>& cells = this->cells(e.id);
         block[0 * 4 + lane] = static_cast<Cell>(e.id);
         block[1 * 4 + lane] = e.lo;
-        for (int k = 0; k < D - 1; ++k) {
-            block[(2 + 2 * k) * 4 + lane] = cells.lo[otherAxis(axis_, k)];
-            block[(3 + 2 * k) * 4 + lane] = cells.hi[otherAxis(axis_, k)];
+        for (int i = 0; i < 2 * (D - 1); ++i) {
+            block[(2 + i) * 4 + lane] = e.other[i];
         }
     }
 
@@ -284,9 +285,13 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     /// other axes.
     template <class Sink>
     void scan(std::uint32_t j, std::uint32_t begin, std::uint32_t end, Sink& candidate) const {
+        // The probe: j's id and first cell, then its reach (hi..., -lo...).
         Cell probe[kFields];
-        for (int f = 0; f < kFields; ++f) {
-            probe[f] = field(j, f);
+        probe[0] = field(j, 0);
+        probe[1] = field(j, 1);
+        for (int k = 0; k < D - 1; ++k) {
+            probe[2 + k] = -field(j, 2 + (D - 1) + k);
+            probe[2 + (D - 1) + k] = -field(j, 2 + k);
         }
         std::uint32_t k = begin;
         // Scalar up to a block boundary, four at a time through whole blocks, scalar tail.
@@ -309,15 +314,13 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     template <class Sink>
     void scanOne(std::uint32_t k, const Cell* probe, Sink& candidate) const {
         const Cell id = field(k, 0), lo = field(k, 1);
-        if (!(lo < probe[1] || id < probe[0])) {
-            return;
+        bool match = lo < probe[1] || id < probe[0];
+        for (int f = 2; f < kFields; ++f) {
+            match &= field(k, f) <= probe[f];
         }
-        for (int f = 2; f < kFields; f += 2) {
-            if (field(k, f) > probe[f + 1] || field(k, f + 1) < probe[f]) {
-                return;
-            }
+        if (match) {
+            candidate(ObjectId(id), ObjectId(probe[0]));
         }
-        candidate(ObjectId(id), ObjectId(probe[0]));
     }
 
     /// Four cells, one per lane (GCC / Clang vector extension: SSE2 on x86-64, NEON on
@@ -335,9 +338,8 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     static bool anyMatch(const Cell* block, const Cell* probe) {
         Lanes match =
             (lanes(block + 4) < broadcast(probe[1])) | (lanes(block) < broadcast(probe[0]));
-        for (int f = 2; f < kFields; f += 2) {
-            match &= (lanes(block + f * 4) <= broadcast(probe[f + 1])) &
-                     (lanes(block + (f + 1) * 4) >= broadcast(probe[f]));
+        for (int f = 2; f < kFields; ++f) {
+            match &= lanes(block + f * 4) <= broadcast(probe[f]);
         }
         return (match[0] | match[1] | match[2] | match[3]) != 0;
     }
