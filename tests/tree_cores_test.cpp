@@ -59,6 +59,7 @@ class CheckedTreeCore {
     }
     std::size_t size() const { return core_.size(); }
     void validate() const { core_.validate(); }
+    const Core& core() const { return core_; }
 
     template <class Sink>
     void findCandidates(Sink&& sink) {
@@ -146,6 +147,13 @@ void runAllCases(std::uint64_t seed) {
             const testkit::CoreScenarioResult result =
                 testkit::runCoreScenario<D, Scalar>(core, scenario);
             testkit::expectMeaningful(result);
+            if (settingsOf<Core>(tree).incremental &&
+                !(std::is_same_v<typename Core::Settings, SegmentTreeSettings> &&
+                  tree.segmentTrees.traversal == SegmentTreeSettings::Traversal::ThesisFlags)) {
+                // Both ways of finding candidates were checked against the definition.
+                EXPECT_GT(core.core().incrementalFrames(), 0u);
+                EXPECT_GT(core.core().fullFrames(), 0u);
+            }
             if (::testing::Test::HasFailure()) {
                 return;
             }

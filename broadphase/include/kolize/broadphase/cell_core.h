@@ -17,7 +17,6 @@
 /// insert and keeps U fitted to a scene that is built up over time.
 
 #include <kolize/broadphase/aabb.h>
-#include <kolize/broadphase/pair_set.h>
 #include <kolize/broadphase/segment_tree.h>
 
 #include <array>
@@ -111,12 +110,14 @@ inline bool cellsOverlap(const CellBox<D>& a, const CellBox<D>& b) {
 
 /// Candidates kept between frames (when `incremental` is on). The candidate set is the
 /// pairs whose cell boxes overlap, and cell boxes change rarely when objects move little:
-/// so the set of the last frame is kept, each object whose cell box changed adds the pairs
-/// its box grew into (queries of the grown slabs only), and pairs whose cell boxes no longer
-/// overlap are dropped while the set is read. Every pair that overlaps now either
-/// overlapped before or lies in the grown part of one of its two objects, so nothing is
-/// missed. When many objects changed cells, the derived core enumerates all pairs instead,
-/// and keeps them when the motion is slow enough that the next frame can be incremental.
+/// so the set of the last frame is kept as a plain list, pairs whose cell boxes no longer
+/// overlap are dropped while it is read, and each object whose cell box changed adds the
+/// new pairs its box grew into (queries of the grown slabs only). A pair that overlaps now
+/// and did not before meets the grown part of at least one of its objects; the rules in
+/// acceptNewPair make exactly one of them add it, so the list never holds a pair twice and
+/// needs no hashing. When many objects changed cells, the derived core enumerates all pairs
+/// instead, and keeps them when the motion is slow enough for the next frame to be
+/// incremental.
 ///
 /// Derived must provide (all called by CellCore only):
 ///   bool hasTree(int axis) const;
@@ -198,6 +199,11 @@ class CellCore {
     /// The leaf width U in use.
     double unit() const { return quantizer_.unit(); }
 
+    /// How the candidates were found so far: frames served from the kept set, and frames
+    /// that enumerated every pair.
+    std::size_t incrementalFrames() const { return incrementalFrames_; }
+    std::size_t fullFrames() const { return fullFrames_; }
+
     /// The cell box of live object `id`.
     const CellBox<D>& cellsOf(ObjectId id) const { return cells_[id]; }
 
@@ -233,31 +239,34 @@ class CellCore {
         retuneBeforeFrame();
         const std::size_t n = live_.size();
         if (keptValid_ && !changesOverflowed_ && changes_.size() * kIncrementalShare <= n) {
+            ++incrementalFrames_;
+            std::size_t kept = 0;
+            for (const KeptPair& pair : kept_) {
+                // A pair of objects that neither changed cells nor went away still overlaps;
+                // an inserted object (perhaps under a removed one's id) has no old pairs.
+                const std::uint32_t a = changeIndex_[pair.first], b = changeIndex_[pair.second];
+                if ((a != 0 || b != 0) &&
+                    (isGone(pair.first, a) || isGone(pair.second, b) ||
+                     !cellsOverlap(cells_[pair.first], cells_[pair.second]))) {
+                    continue;
+                }
+                candidate(pair.first, pair.second);
+                kept_[kept++] = pair;
+            }
+            kept_.resize(kept);
             for (const Change& change : changes_) {
                 if (isLive(change.id)) {
-                    addGrownPairs(change);
+                    addGrownPairs(change, candidate);
                 }
             }
-            kept_.retainIf([&](PairSet::Entry& entry) {
-                const ObjectId a = entry.first(), b = entry.second();
-                // A pair of objects that neither changed cells nor went away still overlaps.
-                const bool touched = changeIndex_[a] != 0 || changeIndex_[b] != 0;
-                if (touched && (!isLive(a) || !isLive(b) || !cellsOverlap(cells_[a], cells_[b]))) {
-                    return false;
-                }
-                candidate(a, b);
-                return true;
-            });
         } else {
+            ++fullFrames_;
             const bool keep = incremental_ && !changesOverflowed_;
-            if (keep) {
-                kept_.clear();
-            }
+            kept_.clear();
             derived().enumerateAll([&](ObjectId a, ObjectId b) {
                 candidate(a, b);
                 if (keep) {
-                    bool inserted = false;
-                    kept_.findOrInsert(a, b, inserted);
+                    kept_.push_back(KeptPair{a, b});
                 }
             });
             keptValid_ = keep;
@@ -346,7 +355,7 @@ class CellCore {
                stay_.capacity() * sizeof(Stay) +
                (position_.capacity() + live_.capacity() + changeIndex_.capacity()) *
                    sizeof(std::uint32_t) +
-               scratch_.capacity() * sizeof(double) + kept_.memoryBytes() +
+               scratch_.capacity() * sizeof(double) + kept_.capacity() * sizeof(KeptPair) +
                changes_.capacity() * sizeof(Change) + removed_.capacity() * sizeof(ObjectId);
     }
 
@@ -396,32 +405,95 @@ class CellCore {
         removed_.push_back(id);
     }
 
-    /// Adds to the kept set the pairs of `change.id` whose cells overlap its grown part.
-    void addGrownPairs(const Change& change) {
+    /// Whether a kept pair's object was removed or (re-)inserted since the last frame.
+    bool isGone(ObjectId id, std::uint32_t changeIndex) const {
+        return changeIndex == kRemovedMark ||
+               (changeIndex != 0 && (!isLive(id) || changes_[changeIndex - 1].inserted));
+    }
+
+    /// The cell box `id` had at the last frame; false when it had none (inserted since).
+    bool oldCellsOf(ObjectId id, const CellBox<D>*& old) const {
+        const std::uint32_t index = changeIndex_[id];
+        if (index == 0) {
+            old = &cells_[id];
+            return true;
+        }
+        const Change& change = changes_[index - 1];
+        old = &change.old;
+        return !change.inserted;
+    }
+
+    /// Adds (and reports) the new pairs of `change.id` that its own queries are responsible
+    /// for: the objects whose cells meet its grown part (all of it when inserted).
+    template <class Sink>
+    void addGrownPairs(const Change& change, Sink& candidate) {
         const ObjectId id = change.id;
         const CellBox<D>& now = cells_[id];
-        auto add = [&](ObjectId other) {
-            if (other != id) {
-                bool inserted = false;
-                kept_.findOrInsert(id, other, inserted);
-            }
-        };
+        std::array<CellBox<D>, 2 * D> slabs;
+        int count = 0;
         if (change.inserted) {
-            derived().visitCells(now, add);
-            return;
+            slabs[count++] = now;
+        } else {
+            for (int axis = 0; axis < D; ++axis) {
+                if (now.lo[axis] < change.old.lo[axis]) {
+                    slabs[count] = now;
+                    slabs[count++].hi[axis] = std::min(now.hi[axis], Cell(change.old.lo[axis] - 1));
+                }
+                if (now.hi[axis] > change.old.hi[axis]) {
+                    slabs[count] = now;
+                    slabs[count++].lo[axis] = std::max(now.lo[axis], Cell(change.old.hi[axis] + 1));
+                }
+            }
         }
+        for (int s = 0; s < count; ++s) {
+            derived().visitCells(slabs[s], [&](ObjectId other) {
+                if (acceptNewPair(change, other, slabs, s)) {
+                    kept_.push_back(KeptPair{id, other});
+                    candidate(id, other);
+                }
+            });
+        }
+    }
+
+    /// Whether `change.id`, having found `other` in its grown slab `s`, adds the pair: it is
+    /// new (their cells did not overlap at the last frame), `other` is not met by an earlier
+    /// slab, and, when `other` changed too and could find the pair itself, the rule picks
+    /// exactly one of them: the smaller id, unless the larger one's grown part misses the
+    /// pair's common cells (then only the larger one's queries find it).
+    bool acceptNewPair(const Change& change, ObjectId other,
+                       const std::array<CellBox<D>, 2 * D>& slabs, int s) const {
+        const ObjectId id = change.id;
+        if (other == id) {
+            return false;
+        }
+        for (int earlier = 0; earlier < s; ++earlier) {
+            if (cellsOverlap(cells_[other], slabs[earlier])) {
+                return false;
+            }
+        }
+        const CellBox<D>* otherOld = nullptr;
+        const bool otherExisted = oldCellsOf(other, otherOld);
+        if (!change.inserted && otherExisted && cellsOverlap(change.old, *otherOld)) {
+            return false;  // kept already
+        }
+        if (changeIndex_[other] == 0 || id < other) {
+            return true;
+        }
+        // `other` changed and has the smaller id: it adds the pair if its grown part meets
+        // the common cells, i.e. unless they lie inside its old box.
+        if (!otherExisted) {
+            return false;
+        }
+        const CellBox<D>& mine = cells_[id];
+        const CellBox<D>& theirs = cells_[other];
         for (int axis = 0; axis < D; ++axis) {
-            if (now.lo[axis] < change.old.lo[axis]) {
-                CellBox<D> slab = now;
-                slab.hi[axis] = std::min(now.hi[axis], Cell(change.old.lo[axis] - 1));
-                derived().visitCells(slab, add);
-            }
-            if (now.hi[axis] > change.old.hi[axis]) {
-                CellBox<D> slab = now;
-                slab.lo[axis] = std::max(now.lo[axis], Cell(change.old.hi[axis] + 1));
-                derived().visitCells(slab, add);
+            const Cell lo = std::max(mine.lo[axis], theirs.lo[axis]);
+            const Cell hi = std::min(mine.hi[axis], theirs.hi[axis]);
+            if (lo < otherOld->lo[axis] || hi > otherOld->hi[axis]) {
+                return false;
             }
         }
+        return true;
     }
 
     CellBox<D> rawCells(const Box& box) const {
@@ -587,7 +659,12 @@ class CellCore {
     std::vector<double> scratch_;
 
     bool incremental_;
-    PairSet kept_;
+    struct KeptPair {
+        ObjectId first, second;
+    };
+    std::vector<KeptPair> kept_;
+    std::size_t incrementalFrames_ = 0;
+    std::size_t fullFrames_ = 0;
     bool keptValid_ = false;
     std::vector<Change> changes_;
     /// Per id: 1 + its index in changes_, kRemovedMark, or 0 when untouched this frame.
