@@ -323,23 +323,14 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         }
     }
 
-    /// Four cells, one per lane (GCC / Clang vector extension: SSE2 on x86-64, NEON on
-    /// ARM, plain code elsewhere).
-    using Lanes = std::int32_t __attribute__((vector_size(16)));
-
-    static Lanes lanes(const Cell* cells) {
-        Lanes out;
-        std::memcpy(&out, cells, sizeof out);
-        return out;
-    }
-    static Lanes broadcast(Cell cell) { return Lanes{cell, cell, cell, cell}; }
+    static CellLanes broadcast(Cell cell) { return CellLanes{cell, cell, cell, cell}; }
 
     /// Whether any of the four entries of `block` passes scanOne's test, branch-free.
     static bool anyMatch(const Cell* block, const Cell* probe) {
-        Lanes match =
-            (lanes(block + 4) < broadcast(probe[1])) | (lanes(block) < broadcast(probe[0]));
+        CellLanes match =
+            (loadLanes(block + 4) < broadcast(probe[1])) | (loadLanes(block) < broadcast(probe[0]));
         for (int f = 2; f < kFields; ++f) {
-            match &= lanes(block + f * 4) <= broadcast(probe[f]);
+            match &= loadLanes(block + f * 4) <= broadcast(probe[f]);
         }
         return (match[0] | match[1] | match[2] | match[3]) != 0;
     }
