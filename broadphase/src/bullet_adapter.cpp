@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -60,6 +61,15 @@ BroadphaseAdapter::~BroadphaseAdapter() {
 }
 
 const char* BroadphaseAdapter::rejectReason(const btVector3& aabbMin, const btVector3& aabbMax) {
+    // Fast path for every setAabb: finite and ordered (NaN fails every comparison).
+    constexpr btScalar kMax = std::numeric_limits<btScalar>::max();
+    bool good = true;
+    for (int axis = 0; axis < 3; ++axis) {
+        good &= aabbMin[axis] <= aabbMax[axis] && aabbMin[axis] >= -kMax && aabbMax[axis] <= kMax;
+    }
+    if (good) {
+        return "";
+    }
     for (int axis = 0; axis < 3; ++axis) {
         if (std::isnan(aabbMin[axis]) || std::isnan(aabbMax[axis])) {
             return "NaN coordinate";

@@ -55,8 +55,9 @@ class CellGrid {
   public:
     using Box = Aabb<D, Scalar>;
     using Settings = CellGridSettings;
-    using Key = CellKey<D>;
-    using Range = CellRange<D>;
+    using Key = typename Index::Key;
+    using Range = typename Index::Range;
+    using Coord = typename Index::Coord;
 
     /// Throws std::invalid_argument for settings that cannot work.
     explicit CellGrid(const Settings& settings = {}) : settings_(settings) {
@@ -82,7 +83,6 @@ class CellGrid {
         object.box = box;
         object.state = State::Waiting;
         ++size_;
-        extentSum_ += clampedExtent(box);
         if (chosen_) {
             place(id);
         } else {
@@ -93,14 +93,17 @@ class CellGrid {
     /// Re-bins the object only when the cells its box covers change.
     void update(ObjectId id, const Box& box) {
         Object& object = objects_[id];
-        extentSum_ += clampedExtent(box) - clampedExtent(object.box);
         object.box = box;
         if (object.state == State::Waiting) {
             return;
         }
         const Range range = rangeOf(box);
-        if (object.state == State::InCells && range == object.range &&
-            !belongsInOverflow(box, range)) {
+        // Same cells: nothing to do (unless a clamped box has left the dense region).
+        if (object.state == State::InCells && range == object.range && !isOutside(box)) {
+            return;
+        }
+        if (object.state == State::InCells && !belongsInOverflow(box, range)) {
+            rebin(id, range);
             return;
         }
         unplace(id);
@@ -109,7 +112,6 @@ class CellGrid {
 
     void remove(ObjectId id) {
         Object& object = objects_[id];
-        extentSum_ -= clampedExtent(object.box);
         if (object.state == State::Waiting) {
             eraseFrom(waiting_, id);
         } else {
@@ -128,8 +130,7 @@ class CellGrid {
         }
         ++framesSinceChoice_;
         contentDirty_ = true;
-        index_.forEachLive([&](std::uint32_t cell) {
-            const CellRecord& record = index_.record(cell);
+        index_.forEachLive([&](std::uint32_t cell, const CellRecord& record) {
             if (record.count < 2) {
                 return;
             }
@@ -332,8 +333,7 @@ class CellGrid {
             fail("waiting list disagrees");
         }
         std::size_t listed = 0;
-        index_.forEachLive([&](std::uint32_t cell) {
-            const CellRecord& record = index_.record(cell);
+        index_.forEachLive([&](std::uint32_t cell, const CellRecord& record) {
             std::uint32_t count = 0, previous = kNone;
             for (std::uint32_t e = record.head; e != kNone; e = entries_[e].next) {
                 if (entries_[e].cell != cell || entries_[e].previous != previous) {
@@ -408,9 +408,20 @@ class CellGrid {
         }
         return extent;
     }
-    /// Extent counted in the drift statistic: huge boxes are capped so a few planes do
-    /// not dominate the mean.
-    double clampedExtent(const Box& box) const { return std::min(largestExtent(box), extentCap_); }
+    /// Mean largest extent over a sample of at most 512 objects, each capped at extentCap_
+    /// so that a few planes do not dominate: the drift statistic.
+    double sampledMeanExtent() const {
+        const std::size_t stride = objects_.size() / 512 + 1;
+        double sum = 0;
+        std::size_t counted = 0;
+        for (std::size_t id = 0; id < objects_.size(); id += stride) {
+            if (objects_[id].state != State::Absent) {
+                sum += std::min(largestExtent(objects_[id].box), extentCap_);
+                ++counted;
+            }
+        }
+        return counted > 0 ? sum / double(counted) : 0;
+    }
 
     Range rangeOf(const Box& box) const {
         Range range;
@@ -420,14 +431,17 @@ class CellGrid {
         }
         return range;
     }
-    std::int64_t coordinate(double x, int axis) const {
-        double c = std::floor((x - origin_[axis]) * inverseCellSize_);
+    Coord coordinate(double x, int axis) const {
+        double c = (x - origin_[axis]) * inverseCellSize_;
+        // Clamp first, then floor by truncation (std::floor is a library call on baseline
+        // x86-64, and this runs for every setAabb).
         if constexpr (Index::kBounded) {
-            c = std::min(std::max(c, 0.0), double(dims_[axis] - 1));
+            c = std::min(std::max(c, 0.0), double(dims_[axis]) - 0.5);
         } else {
             c = std::min(std::max(c, -kKeyLimit), kKeyLimit);
         }
-        return static_cast<std::int64_t>(c);
+        const std::int64_t truncated = static_cast<std::int64_t>(c);
+        return static_cast<Coord>(truncated - (c < double(truncated) ? 1 : 0));
     }
     bool isOutside(const Box& box) const {
         if constexpr (Index::kBounded) {
@@ -478,26 +492,79 @@ class CellGrid {
         object.state = State::InCells;
         object.single = range.lo == range.hi;
         object.firstEntry = kNone;
-        forEachCellIn<D>(range, [&](const Key& key) {
-            const std::uint32_t cell = index_.acquire(key);
-            const std::uint32_t e = newEntry();
-            Entry& entry = entries_[e];
-            CellRecord& record = index_.record(cell);
-            entry.object = id;
-            entry.cell = cell;
-            entry.previous = kNone;
-            entry.next = record.head;
-            if (record.head != kNone) {
-                entries_[record.head].previous = e;
+        forEachCellIn(range, [&](const Key& key) { addEntry(id, key); });
+        growContent(object.box);
+    }
+    /// Moves a binned object to new cells, touching only the cells that change.
+    void rebin(ObjectId id, const Range& range) {
+        Object& object = objects_[id];
+        if (object.single && range.lo == range.hi) {
+            dropEntry(object.firstEntry);
+            object.firstEntry = kNone;
+            addEntry(id, range.lo);
+            object.range = range;
+            growContent(object.box);
+            return;
+        }
+        std::uint32_t* link = &object.firstEntry;
+        while (*link != kNone) {
+            const std::uint32_t e = *link;
+            if (range.contains(index_.key(entries_[e].cell))) {
+                link = &entries_[e].nextOfObject;
+            } else {
+                *link = entries_[e].nextOfObject;
+                dropEntry(e);
             }
-            record.head = e;
-            ++record.count;
-            entry.nextOfObject = objects_[id].firstEntry;
-            objects_[id].firstEntry = e;
+        }
+        const Range old = object.range;
+        forEachCellIn(range, [&](const Key& key) {
+            if (!old.contains(key)) {
+                addEntry(id, key);
+            }
         });
+        object.range = range;
+        object.single = range.lo == range.hi;
+        growContent(object.box);
+    }
+    void addEntry(ObjectId id, const Key& key) {
+        const std::uint32_t cell = index_.acquire(key);
+        const std::uint32_t e = newEntry();
+        Entry& entry = entries_[e];
+        CellRecord& record = index_.record(cell);
+        entry.object = id;
+        entry.cell = cell;
+        entry.previous = kNone;
+        entry.next = record.head;
+        if (record.head != kNone) {
+            entries_[record.head].previous = e;
+        }
+        record.head = e;
+        ++record.count;
+        entry.nextOfObject = objects_[id].firstEntry;
+        objects_[id].firstEntry = e;
+    }
+    /// Unlinks the entry from its cell (releasing the cell when it empties) and frees it;
+    /// the caller unlinks it from its object's list.
+    void dropEntry(std::uint32_t e) {
+        Entry& entry = entries_[e];
+        CellRecord& record = index_.record(entry.cell);
+        if (entry.previous != kNone) {
+            entries_[entry.previous].next = entry.next;
+        } else {
+            record.head = entry.next;
+        }
+        if (entry.next != kNone) {
+            entries_[entry.next].previous = entry.previous;
+        }
+        if (--record.count == 0) {
+            index_.release(entry.cell);
+        }
+        freeEntries_.push_back(e);
+    }
+    void growContent(const Box& box) {
         for (int axis = 0; axis < D; ++axis) {
-            contentLo_[axis] = std::min(contentLo_[axis], double(object.box.lo[axis]));
-            contentHi_[axis] = std::max(contentHi_[axis], double(object.box.hi[axis]));
+            contentLo_[axis] = std::min(contentLo_[axis], double(box.lo[axis]));
+            contentHi_[axis] = std::max(contentHi_[axis], double(box.hi[axis]));
         }
     }
     void unplace(ObjectId id) {
@@ -511,21 +578,8 @@ class CellGrid {
             object.outside = false;
         } else if (object.state == State::InCells) {
             for (std::uint32_t e = object.firstEntry; e != kNone;) {
-                Entry& entry = entries_[e];
-                const std::uint32_t nextOfObject = entry.nextOfObject;
-                CellRecord& record = index_.record(entry.cell);
-                if (entry.previous != kNone) {
-                    entries_[entry.previous].next = entry.next;
-                } else {
-                    record.head = entry.next;
-                }
-                if (entry.next != kNone) {
-                    entries_[entry.next].previous = entry.previous;
-                }
-                if (--record.count == 0) {
-                    index_.release(entry.cell);
-                }
-                freeEntries_.push_back(e);
+                const std::uint32_t nextOfObject = entries_[e].nextOfObject;
+                dropEntry(e);
                 e = nextOfObject;
             }
             object.firstEntry = kNone;
@@ -613,12 +667,17 @@ class CellGrid {
             return false;
         }
         const double factor = settings_.rechooseFactor;
-        const double mean = extentSum_ / double(size_);
         const bool automaticSize = settings_.cellSize == 0 || settings_.cellsPerAxis > 0;
         if (automaticSize &&
-            (double(size_) > double(chosenSize_) * 2 || double(size_) * 2 < double(chosenSize_) ||
-             mean > chosenMeanExtent_ * factor || mean * factor < chosenMeanExtent_)) {
+            (double(size_) > double(chosenSize_) * 2 || double(size_) * 2 < double(chosenSize_))) {
             return true;
+        }
+        // The extent statistic is sampled every 8th frame only.
+        if (automaticSize && framesSinceChoice_ % 8 == 0) {
+            const double mean = sampledMeanExtent();
+            if (mean > chosenMeanExtent_ * factor || mean * factor < chosenMeanExtent_) {
+                return true;
+            }
         }
         if constexpr (Index::kBounded) {
             return outside_ > size_ / 16 + 8 && !regionFixed();
@@ -740,8 +799,8 @@ class CellGrid {
             }
             Key dims{};
             for (int axis = 0; axis < D; ++axis) {
-                dims[axis] = static_cast<std::int64_t>(
-                    std::max(1.0, std::ceil((hi[axis] - lo[axis]) / size)));
+                dims[axis] =
+                    static_cast<Coord>(std::max(1.0, std::ceil((hi[axis] - lo[axis]) / size)));
                 regionLo_[axis] = lo[axis];
                 regionHi_[axis] = lo[axis] + double(dims[axis]) * size;
             }
@@ -762,16 +821,14 @@ class CellGrid {
         waiting_.clear();
         contentLo_.fill(HUGE_VAL);
         contentHi_.fill(-HUGE_VAL);
-        extentSum_ = 0;
         chosen_ = true;
         for (ObjectId id : all) {
             objects_[id].state = State::Waiting;
             objects_[id].firstEntry = kNone;
-            extentSum_ += clampedExtent(objects_[id].box);
             place(id);
         }
         chosenSize_ = size_;
-        chosenMeanExtent_ = size_ > 0 ? extentSum_ / double(size_) : 0;
+        chosenMeanExtent_ = sampledMeanExtent();
         ++rechoices_;
     }
 
@@ -802,7 +859,6 @@ class CellGrid {
     mutable std::array<double, D> contentLo_{};
     mutable std::array<double, D> contentHi_{};
     mutable bool contentDirty_ = false;
-    double extentSum_ = 0;
     std::size_t chosenSize_ = 0;
     double chosenMeanExtent_ = 0;
     std::size_t rechoices_ = 0;

@@ -29,18 +29,20 @@
 
 namespace kolize {
 
-/// Integer cell coordinates.
-template <int D>
-using CellKey = std::array<std::int64_t, D>;
+/// Integer cell coordinates: 64-bit for the unbounded sparse indexes, 32-bit for the dense
+/// grid (whose cells are counted in 32 bits anyway), which halves its per-object state.
+template <int D, class Coord = std::int64_t>
+using CellKey = std::array<Coord, D>;
 
 /// An inclusive box of cells.
-template <int D>
+template <int D, class Coord = std::int64_t>
 struct CellRange {
-    CellKey<D> lo{};
-    CellKey<D> hi{};
+    using Key = CellKey<D, Coord>;
+    Key lo{};
+    Key hi{};
     bool operator==(const CellRange& other) const { return lo == other.lo && hi == other.hi; }
     bool operator!=(const CellRange& other) const { return !(*this == other); }
-    bool contains(const CellKey<D>& key) const {
+    bool contains(const Key& key) const {
         for (int axis = 0; axis < D; ++axis) {
             if (key[axis] < lo[axis] || key[axis] > hi[axis]) {
                 return false;
@@ -59,9 +61,9 @@ struct CellRange {
 };
 
 /// Calls visit(key) for every cell of `range`, x slowest. The range must be small.
-template <int D, class Visit>
-void forEachCellIn(const CellRange<D>& range, Visit&& visit) {
-    CellKey<D> key = range.lo;
+template <int D, class Coord, class Visit>
+void forEachCellIn(const CellRange<D, Coord>& range, Visit&& visit) {
+    CellKey<D, Coord> key = range.lo;
     while (true) {
         visit(key);
         int axis = D - 1;
@@ -84,102 +86,112 @@ struct CellRecord {
 
 constexpr std::uint32_t kNoCell = 0xffffffffu;
 
-/// A dense array of cells over [0, dims) on each axis.
+/// A dense array of cells over [0, dims) on each axis. The array holds only a 4-byte slot
+/// number per cell; the records of the non-empty cells live together in a compact slot
+/// array, so a pair search walks them sequentially, not the whole region.
 template <int D>
 class DenseIndex {
   public:
     static constexpr bool kBounded = true;
     static constexpr const char* kName = "dense array";
+    using Coord = std::int32_t;
+    using Key = CellKey<D, Coord>;
+    using Range = CellRange<D, Coord>;
 
     /// Drops all cells and sizes the array for `dims` cells per axis.
-    void reset(const CellKey<D>& dims) {
+    void reset(const Key& dims) {
         dims_ = dims;
         std::size_t total = 1;
         for (int axis = 0; axis < D; ++axis) {
             total *= static_cast<std::size_t>(dims[axis]);
         }
-        cells_.assign(total, CellRecord{});
-        livePosition_.assign(total, kNoCell);
-        live_.clear();
+        slotOf_.assign(total, kNoCell);
+        slots_.clear();
     }
-    std::uint32_t find(const CellKey<D>& key) const {
+    std::uint32_t find(const Key& key) const {
         const std::uint32_t handle = handleOf(key);
-        return cells_[handle].count != 0 ? handle : kNoCell;
+        return slotOf_[handle] != kNoCell ? handle : kNoCell;
     }
     /// Finds the cell or makes it live.
-    std::uint32_t acquire(const CellKey<D>& key) {
+    std::uint32_t acquire(const Key& key) {
         const std::uint32_t handle = handleOf(key);
-        if (livePosition_[handle] == kNoCell) {
-            livePosition_[handle] = static_cast<std::uint32_t>(live_.size());
-            live_.push_back(handle);
+        if (slotOf_[handle] == kNoCell) {
+            slotOf_[handle] = static_cast<std::uint32_t>(slots_.size());
+            slots_.push_back(Slot{CellRecord{}, handle});
         }
         return handle;
     }
     /// Called when the cell's last object has left.
     void release(std::uint32_t handle) {
-        const std::uint32_t at = livePosition_[handle];
-        live_[at] = live_.back();
-        livePosition_[live_[at]] = at;
-        live_.pop_back();
-        livePosition_[handle] = kNoCell;
+        const std::uint32_t at = slotOf_[handle];
+        slots_[at] = slots_.back();
+        slotOf_[slots_[at].handle] = at;
+        slots_.pop_back();
+        slotOf_[handle] = kNoCell;
     }
-    CellRecord& record(std::uint32_t handle) { return cells_[handle]; }
-    const CellRecord& record(std::uint32_t handle) const { return cells_[handle]; }
-    CellKey<D> key(std::uint32_t handle) const {
-        CellKey<D> out{};
+    CellRecord& record(std::uint32_t handle) { return slots_[slotOf_[handle]].record; }
+    const CellRecord& record(std::uint32_t handle) const { return slots_[slotOf_[handle]].record; }
+    Key key(std::uint32_t handle) const {
+        Key out{};
         for (int axis = D - 1; axis >= 0; --axis) {
             out[axis] = handle % static_cast<std::uint32_t>(dims_[axis]);
             handle /= static_cast<std::uint32_t>(dims_[axis]);
         }
         return out;
     }
-    std::size_t liveCount() const { return live_.size(); }
+    std::size_t liveCount() const { return slots_.size(); }
+    /// Calls visit(handle, record) for every live cell.
     template <class Visit>
     void forEachLive(Visit&& visit) const {
-        for (std::uint32_t handle : live_) {
-            visit(handle);
+        for (const Slot& slot : slots_) {
+            visit(slot.handle, slot.record);
         }
     }
     /// Calls visit(handle) for every live cell in `range`.
     template <class Visit>
-    void forEachLiveIn(const CellRange<D>& range, Visit&& visit) const {
-        if (range.cellCount() <= double(live_.size())) {
-            forEachCellIn<D>(range, [&](const CellKey<D>& key) {
+    void forEachLiveIn(const Range& range, Visit&& visit) const {
+        if (range.cellCount() <= double(slots_.size())) {
+            forEachCellIn(range, [&](const Key& key) {
                 const std::uint32_t handle = handleOf(key);
-                if (cells_[handle].count != 0) {
+                if (slotOf_[handle] != kNoCell) {
                     visit(handle);
                 }
             });
             return;
         }
-        for (std::uint32_t handle : live_) {
-            if (range.contains(key(handle))) {
-                visit(handle);
+        for (const Slot& slot : slots_) {
+            if (range.contains(key(slot.handle))) {
+                visit(slot.handle);
             }
         }
     }
     void validate() const {
-        for (std::size_t at = 0; at < live_.size(); ++at) {
-            if (livePosition_[live_[at]] != at || cells_[live_[at]].count == 0) {
-                throw std::logic_error("DenseIndex: live list broken at " + std::to_string(at));
+        for (std::size_t at = 0; at < slots_.size(); ++at) {
+            if (slots_[at].handle >= slotOf_.size() || slotOf_[slots_[at].handle] != at ||
+                slots_[at].record.count == 0) {
+                throw std::logic_error("DenseIndex: slot " + std::to_string(at) +
+                                       " is unreachable or empty");
             }
         }
-        std::size_t nonEmpty = 0;
-        for (const CellRecord& cell : cells_) {
-            nonEmpty += cell.count != 0 ? 1 : 0;
+        std::size_t mapped = 0;
+        for (std::uint32_t slot : slotOf_) {
+            mapped += slot != kNoCell ? 1 : 0;
         }
-        if (nonEmpty != live_.size()) {
-            throw std::logic_error("DenseIndex: a non-empty cell is missing from the live list");
+        if (mapped != slots_.size()) {
+            throw std::logic_error("DenseIndex: a cell maps to a slot that does not map back");
         }
     }
     std::size_t memoryBytes() const {
-        return cells_.capacity() * sizeof(CellRecord) +
-               (livePosition_.capacity() + live_.capacity()) * sizeof(std::uint32_t);
+        return slotOf_.capacity() * sizeof(std::uint32_t) + slots_.capacity() * sizeof(Slot);
     }
-    std::size_t cellCount() const { return cells_.size(); }
+    std::size_t cellCount() const { return slotOf_.size(); }
 
   private:
-    std::uint32_t handleOf(const CellKey<D>& key) const {
+    struct Slot {
+        CellRecord record;
+        std::uint32_t handle;
+    };
+    std::uint32_t handleOf(const Key& key) const {
         std::uint64_t handle = 0;
         for (int axis = 0; axis < D; ++axis) {
             handle = handle * static_cast<std::uint64_t>(dims_[axis]) +
@@ -188,10 +200,9 @@ class DenseIndex {
         return static_cast<std::uint32_t>(handle);
     }
 
-    CellKey<D> dims_{};
-    std::vector<CellRecord> cells_;
-    std::vector<std::uint32_t> livePosition_;
-    std::vector<std::uint32_t> live_;
+    Key dims_{};
+    std::vector<std::uint32_t> slotOf_;
+    std::vector<Slot> slots_;
 };
 
 /// Lexicographic order of cell keys: x first, as the thesis's key formula orders them.
@@ -213,11 +224,12 @@ class SparsePool {
     const CellRecord& record(std::uint32_t handle) const { return nodes_[handle].record; }
     CellKey<D> key(std::uint32_t handle) const { return nodes_[handle].key; }
     std::size_t liveCount() const { return live_; }
+    /// Calls visit(handle, record) for every live cell.
     template <class Visit>
     void forEachLive(Visit&& visit) const {
         for (std::uint32_t handle = 0; handle < nodes_.size(); ++handle) {
             if (nodes_[handle].live) {
-                visit(handle);
+                visit(handle, nodes_[handle].record);
             }
         }
     }
@@ -294,6 +306,9 @@ class AvlIndex : public SparsePool<D, detail::AvlNode<D>> {
   public:
     static constexpr bool kBounded = false;
     static constexpr const char* kName = "AVL tree";
+    using Coord = std::int64_t;
+    using Key = CellKey<D>;
+    using Range = CellRange<D>;
 
     void clear() { *this = AvlIndex{}; }
     std::uint32_t find(const CellKey<D>& key) const {
@@ -324,7 +339,7 @@ class AvlIndex : public SparsePool<D, detail::AvlNode<D>> {
     template <class Visit>
     void forEachLiveIn(const CellRange<D>& range, Visit&& visit) const {
         if (range.cellCount() <= double(this->liveCount()) / 8) {
-            forEachCellIn<D>(range, [&](const CellKey<D>& key) {
+            forEachCellIn(range, [&](const CellKey<D>& key) {
                 const std::uint32_t handle = find(key);
                 if (handle != kNoCell) {
                     visit(handle);
@@ -494,6 +509,9 @@ class HashIndex : public SparsePool<D, detail::HashNode<D>> {
   public:
     static constexpr bool kBounded = false;
     static constexpr const char* kName = "hash table";
+    using Coord = std::int64_t;
+    using Key = CellKey<D>;
+    using Range = CellRange<D>;
 
     void clear() { *this = HashIndex{}; }
     std::uint32_t find(const CellKey<D>& key) const {
@@ -546,7 +564,7 @@ class HashIndex : public SparsePool<D, detail::HashNode<D>> {
     template <class Visit>
     void forEachLiveIn(const CellRange<D>& range, Visit&& visit) const {
         if (range.cellCount() <= double(this->liveCount())) {
-            forEachCellIn<D>(range, [&](const CellKey<D>& key) {
+            forEachCellIn(range, [&](const CellKey<D>& key) {
                 const std::uint32_t handle = find(key);
                 if (handle != kNoCell) {
                     visit(handle);
@@ -554,7 +572,7 @@ class HashIndex : public SparsePool<D, detail::HashNode<D>> {
             });
             return;
         }
-        this->forEachLive([&](std::uint32_t handle) {
+        this->forEachLive([&](std::uint32_t handle, const CellRecord&) {
             if (range.contains(nodes_[handle].key)) {
                 visit(handle);
             }
@@ -597,7 +615,7 @@ class HashIndex : public SparsePool<D, detail::HashNode<D>> {
         const std::size_t size = table_.empty() ? 64 : table_.size() * 2;
         table_.assign(size, kNoCell);
         mask_ = size - 1;
-        this->forEachLive([&](std::uint32_t handle) {
+        this->forEachLive([&](std::uint32_t handle, const CellRecord&) {
             std::size_t at = slotOf(nodes_[handle].key);
             while (table_[at] != kNoCell) {
                 at = (at + 1) & mask_;

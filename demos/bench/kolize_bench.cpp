@@ -1,0 +1,416 @@
+// kolize-bench: the thesis's scenes (DIGEST section 7) as a pure broadphase benchmark, every
+// broadphase side by side in one run. Per frame: setAabb for every proxy, then
+// calculateOverlappingPairs through a btCollisionDispatcher. Reports init time (creating
+// the proxies and the first pair search), the per-frame median, pairs, their errors against
+// the exact truth in the last frame, candidates, and the peak heap the broadphase held.
+
+#include "memory_meter.h"
+
+#include <kolize/broadphase/bullet_adapter.h>
+#include <kolize/engine/pair_compare.h>
+#include <kolize/engine/thesis_scene.h>
+#include <kolize/kolize.h>
+
+#include <btBulletCollisionCommon.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+using kolize::ThesisLayout;
+using kolize::ThesisMotion;
+
+const char* kUsage =
+    "usage: kolize-bench [options]\n"
+    "The thesis's scenes: space -500..500, cubes of edge 2 turning and moving; A uniform,\n"
+    "B with 95%% of the cubes in a cluster cube of edge 80. Per frame: setAabb for every\n"
+    "proxy + calculateOverlappingPairs. Times are medians over the frames.\n"
+    "  --scene A|B|all          (default all)\n"
+    "  --motion slow|fast|all   (default all)\n"
+    "  --n LIST                 object counts, comma separated\n"
+    "                           (default 250,500,750,1000,1500,2000,3000,10000,100000)\n"
+    "  --frames F               frames per run (default 60; at most 15 for N >= 100000)\n"
+    "  --broadphase LIST        comma separated; an entry may carry settings after a colon:\n"
+    "                           NAME:cell=X (fixed cell edge), NAME:factor=X (cell edge in\n"
+    "                           median extents), NAME:cells-per-object=X (dense grid\n"
+    "                           budget), NAME:per-axis=K (thesis sizing: K cells\n"
+    "                           per axis over the scene). Default: the kolize broadphases,\n"
+    "                           grid:per-axis=17 and spatial-tree:per-axis=17 (the thesis's\n"
+    "                           configuration), dbvt, sap, sap-noray, sap32, brute-force.\n"
+    "                           Names: %s\n"
+    "  --seed S                 scene seed (default 1)\n"
+    "  --csv FILE               also write one row per run\n"
+    "  --help                   this text\n"
+    "brute-force and simple are skipped above N = 20000 (O(N^2) per frame); sap and\n"
+    "sap-noray above 32766 objects (btAxisSweep3's 16-bit handles).\n";
+
+struct Options {
+    std::vector<ThesisLayout> layouts = {ThesisLayout::Uniform, ThesisLayout::Clustered};
+    std::vector<ThesisMotion> motions = {ThesisMotion::Slow, ThesisMotion::Fast};
+    std::vector<int> counts = {250, 500, 750, 1000, 1500, 2000, 3000, 10000, 100000};
+    int frames = 60;
+    std::vector<std::string> broadphases;
+    std::uint32_t seed = 1;
+    std::string csv;
+};
+
+std::string joinedNames() {
+    std::string out;
+    for (const std::string& name : kolize::broadphaseNames()) {
+        out += (out.empty() ? "" : ", ") + name;
+    }
+    return out;
+}
+
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "kolize-bench: %s (try --help)\n", message.c_str());
+    std::exit(2);
+}
+
+std::vector<std::string> split(const std::string& text, char separator) {
+    std::vector<std::string> out;
+    std::stringstream stream(text);
+    std::string item;
+    while (std::getline(stream, item, separator)) {
+        out.push_back(item);
+    }
+    return out;
+}
+
+double number(const std::string& what, const std::string& text) {
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !(value > 0) || !std::isfinite(value)) {
+        fail(what + " needs a positive number, got '" + text + "'");
+    }
+    return value;
+}
+
+/// A broadphase name with optional settings: "grid", "grid:per-axis=17".
+struct Entry {
+    std::string label;
+    std::string name;
+    kolize::BroadphaseSettings settings;
+};
+
+Entry parseEntry(const std::string& text) {
+    Entry entry;
+    entry.label = text;
+    const std::vector<std::string> parts = split(text, ':');
+    entry.name = parts.empty() ? "" : parts[0];
+    const auto& names = kolize::broadphaseNames();
+    if (std::find(names.begin(), names.end(), entry.name) == names.end()) {
+        fail("unknown broadphase '" + entry.name + "'; valid: " + joinedNames());
+    }
+    for (std::size_t i = 1; i < parts.size(); ++i) {
+        const std::vector<std::string> keyValue = split(parts[i], '=');
+        if (keyValue.size() != 2) {
+            fail("setting '" + parts[i] + "' of '" + text + "' is not KEY=VALUE");
+        }
+        const std::string& key = keyValue[0];
+        const double value = number(key, keyValue[1]);
+        if (key == "cell") {
+            entry.settings.cells.cellSize = value;
+        } else if (key == "factor") {
+            entry.settings.cells.sizeFactor = value;
+        } else if (key == "cells-per-object") {
+            entry.settings.cells.cellsPerObject = value;
+        } else if (key == "per-axis") {
+            entry.settings.cells.cellsPerAxis = static_cast<int>(value);
+        } else {
+            fail("unknown setting '" + key + "' in '" + text +
+                 "' (cell, factor, "
+                 "cells-per-object, per-axis)");
+        }
+    }
+    return entry;
+}
+
+Options parse(int argc, char** argv) {
+    Options options;
+    std::vector<std::string> broadphases;
+    for (int i = 1; i < argc; ++i) {
+        const std::string flag = argv[i];
+        if (flag == "--help" || flag == "-h") {
+            std::printf(kUsage, joinedNames().c_str());
+            std::exit(0);
+        }
+        if (i + 1 >= argc) {
+            fail(flag.rfind("--", 0) == 0 ? flag + " needs a value"
+                                          : "unknown argument '" + flag + "'");
+        }
+        const std::string value = argv[++i];
+        if (flag == "--scene") {
+            if (value == "A") {
+                options.layouts = {ThesisLayout::Uniform};
+            } else if (value == "B") {
+                options.layouts = {ThesisLayout::Clustered};
+            } else if (value != "all") {
+                fail("--scene takes A, B or all, got '" + value + "'");
+            }
+        } else if (flag == "--motion") {
+            if (value == "slow") {
+                options.motions = {ThesisMotion::Slow};
+            } else if (value == "fast") {
+                options.motions = {ThesisMotion::Fast};
+            } else if (value != "all") {
+                fail("--motion takes slow, fast or all, got '" + value + "'");
+            }
+        } else if (flag == "--n") {
+            options.counts.clear();
+            for (const std::string& item : split(value, ',')) {
+                const double n = number("--n", item);
+                if (n != std::floor(n) || n > 5e6) {
+                    fail("--n needs whole numbers up to 5000000, got '" + item + "'");
+                }
+                options.counts.push_back(static_cast<int>(n));
+            }
+        } else if (flag == "--frames") {
+            const double frames = number("--frames", value);
+            if (frames != std::floor(frames) || frames > 1e6) {
+                fail("--frames needs a whole number, got '" + value + "'");
+            }
+            options.frames = static_cast<int>(frames);
+        } else if (flag == "--broadphase") {
+            broadphases = split(value, ',');
+        } else if (flag == "--seed") {
+            options.seed = static_cast<std::uint32_t>(number("--seed", value));
+        } else if (flag == "--csv") {
+            options.csv = value;
+        } else {
+            fail("unknown option '" + flag + "'");
+        }
+    }
+    if (broadphases.empty()) {
+        for (const std::string& name : kolize::broadphaseNames()) {
+            if (kolize::isExactBroadphase(name) && name != "brute-force") {
+                broadphases.push_back(name);
+            }
+        }
+        broadphases.insert(broadphases.end(), {"grid:per-axis=17", "spatial-tree:per-axis=17",
+                                               "dbvt", "sap", "sap-noray", "sap32", "brute-force"});
+    }
+    options.broadphases = broadphases;
+    for (const std::string& text : broadphases) {
+        parseEntry(text);  // fails early on a bad entry
+    }
+    return options;
+}
+
+double median(std::vector<double> values) {
+    if (values.empty()) {
+        return 0;
+    }
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    return values[values.size() / 2];
+}
+
+struct Row {
+    std::string label;
+    std::string skipped;  ///< why the run was skipped, or empty
+    double initMs = 0;
+    double frameMs = 0;
+    std::size_t pairs = 0;
+    std::size_t missing = 0;
+    std::size_t extra = 0;
+    std::size_t candidates = 0;  ///< kolize broadphases: candidates in the last frame
+    std::size_t peakBytes = 0;
+};
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+btVector3 vec(const std::array<double, 3>& v) {
+    return btVector3(btScalar(v[0]), btScalar(v[1]), btScalar(v[2]));
+}
+
+Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, int frames) {
+    Row row;
+    row.label = entry.label;
+    const int n = sceneSettings.objects;
+    if ((entry.name == "brute-force" || entry.name == "simple") && n > 20000) {
+        row.skipped = "O(N^2)";
+        return row;
+    }
+    if ((entry.name == "sap" || entry.name == "sap-noray") && n > 32766) {
+        row.skipped = "max 32766 proxies";
+        return row;
+    }
+    kolize::ThesisScene<3> scene(sceneSettings);
+    btDefaultCollisionConfiguration configuration;
+    btCollisionDispatcher dispatcher(&configuration);
+    kolize::BroadphaseSettings settings = entry.settings;
+    const btScalar bound = btScalar(sceneSettings.halfSpace * 1.01);
+    settings.worldMin = btVector3(-bound, -bound, -bound);
+    settings.worldMax = btVector3(bound, bound, bound);
+    settings.maxProxies = std::max(n + 2, 2);
+    kolize::bench::resetPeak();
+    std::unique_ptr<btBroadphaseInterface> broadphase =
+        kolize::makeBroadphase(entry.name, settings);
+    std::vector<btBroadphaseProxy*> proxies(static_cast<std::size_t>(n));
+    const Clock::time_point initStart = Clock::now();
+    for (int i = 0; i < n; ++i) {
+        const auto& box = scene.boxes()[static_cast<std::size_t>(i)];
+        proxies[static_cast<std::size_t>(i)] = broadphase->createProxy(
+            vec(box.lo), vec(box.hi), BOX_SHAPE_PROXYTYPE,
+            reinterpret_cast<void*>(static_cast<std::uintptr_t>(i + 1)), 1, -1, &dispatcher);
+    }
+    broadphase->calculateOverlappingPairs(&dispatcher);
+    row.initMs = msSince(initStart);
+    std::vector<double> frameMs;
+    for (int frame = 0; frame < frames; ++frame) {
+        scene.step();
+        const Clock::time_point start = Clock::now();
+        for (int i = 0; i < n; ++i) {
+            const auto& box = scene.boxes()[static_cast<std::size_t>(i)];
+            broadphase->setAabb(proxies[static_cast<std::size_t>(i)], vec(box.lo), vec(box.hi),
+                                &dispatcher);
+        }
+        broadphase->calculateOverlappingPairs(&dispatcher);
+        frameMs.push_back(msSince(start));
+    }
+    row.frameMs = median(frameMs);
+    row.peakBytes = kolize::bench::peakBytesSinceReset();
+    // Errors of the last frame against the exact truth.
+    std::vector<kolize::ProxyBox> boxes;
+    boxes.reserve(proxies.size());
+    for (int i = 0; i < n; ++i) {
+        const auto& box = scene.boxes()[static_cast<std::size_t>(i)];
+        boxes.push_back({proxies[static_cast<std::size_t>(i)], vec(box.lo), vec(box.hi)});
+    }
+    const std::vector<kolize::UidPair> reported =
+        kolize::cachedPairs(*broadphase->getOverlappingPairCache());
+    const kolize::PairDifference difference =
+        kolize::comparePairs(kolize::exactPairs(boxes, nullptr), reported);
+    row.pairs = reported.size();
+    row.missing = difference.missing.size();
+    row.extra = difference.extra.size();
+    if (const auto* ours = dynamic_cast<const kolize::BroadphaseAdapter*>(broadphase.get())) {
+        row.candidates = ours->stats().candidatesLastFrame;
+    }
+    for (btBroadphaseProxy* proxy : proxies) {
+        broadphase->destroyProxy(proxy, &dispatcher);
+    }
+    return row;
+}
+
+bool isBullet(const std::string& name) {
+    return !kolize::isExactBroadphase(name) && name != "simple";
+}
+
+void progress(const std::string& what) {
+    static const bool terminal = isatty(STDERR_FILENO) != 0;
+    if (terminal) {
+        std::fprintf(stderr, "\r%-70s", what.c_str());
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    kolize::bench::countBulletAllocations();
+    const Options options = parse(argc, argv);
+    std::vector<Entry> entries;
+    for (const std::string& text : options.broadphases) {
+        entries.push_back(parseEntry(text));
+    }
+    std::FILE* csv = nullptr;
+    if (!options.csv.empty()) {
+        csv = std::fopen(options.csv.c_str(), "w");
+        if (csv == nullptr) {
+            fail("cannot write '" + options.csv + "'");
+        }
+        std::fprintf(csv,
+                     "scene,motion,n,broadphase,skipped,init_ms,frame_ms,ratio_to_best_bullet,"
+                     "pairs,missing,extra,candidates,peak_bytes\n");
+    }
+    std::printf(
+        "kolize-bench: thesis scenes, Bullet %d, %s precision, seed %u; frame = setAabb "
+        "x N + calculateOverlappingPairs; times are medians; errors in the last frame\n",
+        btGetVersion(), sizeof(btScalar) == 8 ? "double" : "float", options.seed);
+    for (ThesisLayout layout : options.layouts) {
+        for (ThesisMotion motion : options.motions) {
+            for (int n : options.counts) {
+                kolize::ThesisSceneSettings sceneSettings;
+                sceneSettings.layout = layout;
+                sceneSettings.motion = motion;
+                sceneSettings.objects = n;
+                sceneSettings.seed = options.seed;
+                const int frames = n >= 100000 ? std::min(options.frames, 15) : options.frames;
+                std::vector<Row> rows;
+                for (const Entry& entry : entries) {
+                    progress(std::string("scene ") + kolize::layoutName(layout) + " " +
+                             kolize::motionName(motion) + " N=" + std::to_string(n) + ": " +
+                             entry.label);
+                    rows.push_back(run(entry, sceneSettings, frames));
+                }
+                progress("");
+                double best = 0;
+                std::string bestName;
+                for (std::size_t i = 0; i < rows.size(); ++i) {
+                    if (rows[i].skipped.empty() && isBullet(entries[i].name) &&
+                        (best == 0 || rows[i].frameMs < best)) {
+                        best = rows[i].frameMs;
+                        bestName = rows[i].label;
+                    }
+                }
+                std::printf(
+                    "\nscene %s, %s motion, N = %d, %d frames (ratio: frame time / best "
+                    "of Bullet's, %s)\n",
+                    kolize::layoutName(layout), kolize::motionName(motion), n, frames,
+                    bestName.empty() ? "none run" : bestName.c_str());
+                std::printf("| %-26s | %9s | %9s | %6s | %8s | %7s | %7s | %10s | %8s |\n",
+                            "broadphase", "init ms", "frame ms", "ratio", "pairs", "missing",
+                            "extra", "candidates", "peak MiB");
+                std::printf("|%s|%s|%s|%s|%s|%s|%s|%s|%s|\n", std::string(28, '-').c_str(),
+                            std::string(11, '-').c_str(), std::string(11, '-').c_str(),
+                            std::string(8, '-').c_str(), std::string(10, '-').c_str(),
+                            std::string(9, '-').c_str(), std::string(9, '-').c_str(),
+                            std::string(12, '-').c_str(), std::string(10, '-').c_str());
+                for (const Row& row : rows) {
+                    if (!row.skipped.empty()) {
+                        std::printf("| %-26s | skipped: %s\n", row.label.c_str(),
+                                    row.skipped.c_str());
+                    } else {
+                        char candidates[32] = "-";
+                        if (kolize::isExactBroadphase(split(row.label, ':')[0])) {
+                            std::snprintf(candidates, sizeof candidates, "%zu", row.candidates);
+                        }
+                        std::printf(
+                            "| %-26s | %9.3f | %9.4f | %6.3f | %8zu | %7zu | %7zu | %10s | %8.2f "
+                            "|\n",
+                            row.label.c_str(), row.initMs, row.frameMs,
+                            best > 0 ? row.frameMs / best : 0.0, row.pairs, row.missing, row.extra,
+                            candidates, double(row.peakBytes) / (1024.0 * 1024.0));
+                    }
+                    if (csv != nullptr) {
+                        std::fprintf(csv, "%s,%s,%d,%s,%s,%.6f,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu\n",
+                                     kolize::layoutName(layout), kolize::motionName(motion), n,
+                                     row.label.c_str(), row.skipped.c_str(), row.initMs,
+                                     row.frameMs, best > 0 ? row.frameMs / best : 0.0, row.pairs,
+                                     row.missing, row.extra, row.candidates, row.peakBytes);
+                    }
+                }
+                std::fflush(stdout);
+            }
+        }
+    }
+    if (csv != nullptr) {
+        std::fclose(csv);
+    }
+    return 0;
+}
