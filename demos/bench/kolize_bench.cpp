@@ -46,15 +46,26 @@ const char* kUsage =
     "                           NAME:cell=X (fixed cell edge), NAME:factor=X (cell edge in\n"
     "                           median extents), NAME:cells-per-object=X (dense grid\n"
     "                           budget), NAME:per-axis=K (thesis sizing: K cells\n"
-    "                           per axis over the scene). Default: the kolize broadphases,\n"
+    "                           per axis over the scene); for segment-trees and range-tree:\n"
+    "                           NAME:divisions=S (the thesis's S, leaf width = scene / S),\n"
+    "                           NAME:unit=U (fixed leaf width), segment-trees:traversal=thesis\n"
+    "                           (the thesis's flag walk), NAME:incremental=off (enumerate\n"
+    "                           every frame), range-tree:lists=whole (scan node lists whole).\n"
+    "                           Default: the kolize broadphases,\n"
     "                           grid:per-axis=17 and spatial-tree:per-axis=17 (the thesis's\n"
     "                           configuration), dbvt, sap, sap-noray, sap32, brute-force.\n"
     "                           Names: %s\n"
+    "  --s-sweep LIST           the thesis's S sweep (tables 2.1, 2.2) instead: each tree\n"
+    "                           broadphase given (default segment-trees, range-tree) with\n"
+    "                           divisions = each S; prints frame time, candidates, pairs and\n"
+    "                           the candidates the exact test rejected (thesis: 100,500,1000,\n"
+    "                           1500,2000,5000)\n"
     "  --seed S                 scene seed (default 1)\n"
     "  --csv FILE               also write one row per run\n"
     "  --help                   this text\n"
     "brute-force and simple are skipped above N = 20000 (O(N^2) per frame); sap and\n"
-    "sap-noray above 32766 objects (btAxisSweep3's 16-bit handles).\n";
+    "sap-noray above 32766 objects (btAxisSweep3's 16-bit handles). With both motions, a\n"
+    "closing table puts slow and fast side by side (thesis table 2.7).\n";
 
 struct Options {
     std::vector<ThesisLayout> layouts = {ThesisLayout::Uniform, ThesisLayout::Clustered};
@@ -64,6 +75,7 @@ struct Options {
     std::vector<std::string> broadphases;
     std::uint32_t seed = 1;
     std::string csv;
+    std::vector<int> sweep;  ///< S values of --s-sweep, empty without it
 };
 
 std::string joinedNames() {
@@ -120,8 +132,29 @@ Entry parseEntry(const std::string& text) {
             fail("setting '" + parts[i] + "' of '" + text + "' is not KEY=VALUE");
         }
         const std::string& key = keyValue[0];
-        const double value = number(key, keyValue[1]);
-        if (key == "cell") {
+        const std::string& word = keyValue[1];
+        if (key == "traversal" && (word == "thesis" || word == "stabbing")) {
+            entry.settings.segmentTrees.traversal =
+                word == "thesis" ? kolize::SegmentTreeSettings::Traversal::ThesisFlags
+                                 : kolize::SegmentTreeSettings::Traversal::Stabbing;
+            continue;
+        }
+        if (key == "incremental" && (word == "on" || word == "off")) {
+            entry.settings.segmentTrees.incremental = entry.settings.rangeTree.incremental =
+                word == "on";
+            continue;
+        }
+        if (key == "lists" && (word == "search" || word == "whole")) {
+            entry.settings.rangeTree.searchSortedLists = word == "search";
+            continue;
+        }
+        const double value = number(key, word);
+        if (key == "divisions") {
+            entry.settings.segmentTrees.cells.divisions = entry.settings.rangeTree.cells.divisions =
+                static_cast<int>(value);
+        } else if (key == "unit") {
+            entry.settings.segmentTrees.cells.unit = entry.settings.rangeTree.cells.unit = value;
+        } else if (key == "cell") {
             entry.settings.cells.cellSize = value;
         } else if (key == "factor") {
             entry.settings.cells.sizeFactor = value;
@@ -131,8 +164,8 @@ Entry parseEntry(const std::string& text) {
             entry.settings.cells.cellsPerAxis = static_cast<int>(value);
         } else {
             fail("unknown setting '" + key + "' in '" + text +
-                 "' (cell, factor, "
-                 "cells-per-object, per-axis)");
+                 "' (cell, factor, cells-per-object, per-axis, divisions, unit, "
+                 "traversal=thesis|stabbing, incremental=on|off, lists=search|whole)");
         }
     }
     return entry;
@@ -185,6 +218,14 @@ Options parse(int argc, char** argv) {
             options.frames = static_cast<int>(frames);
         } else if (flag == "--broadphase") {
             broadphases = split(value, ',');
+        } else if (flag == "--s-sweep") {
+            for (const std::string& item : split(value, ',')) {
+                const double divisions = number("--s-sweep", item);
+                if (divisions != std::floor(divisions) || divisions > 1e7) {
+                    fail("--s-sweep needs whole numbers, got '" + item + "'");
+                }
+                options.sweep.push_back(static_cast<int>(divisions));
+            }
         } else if (flag == "--seed") {
             options.seed = static_cast<std::uint32_t>(number("--seed", value));
         } else if (flag == "--csv") {
@@ -193,7 +234,9 @@ Options parse(int argc, char** argv) {
             fail("unknown option '" + flag + "'");
         }
     }
-    if (broadphases.empty()) {
+    if (broadphases.empty() && !options.sweep.empty()) {
+        broadphases = {"segment-trees", "range-tree"};
+    } else if (broadphases.empty()) {
         for (const std::string& name : kolize::broadphaseNames()) {
             if (kolize::isExactBroadphase(name) && name != "brute-force") {
                 broadphases.push_back(name);
@@ -319,6 +362,84 @@ void progress(const std::string& what) {
     }
 }
 
+/// The thesis's S sweep (its tables 2.1 and 2.2): every tree broadphase with each S, the
+/// frame time against the cost of quantisation (candidates the exact test rejected).
+void sweepDivisions(const Options& options, const std::vector<Entry>& entries) {
+    for (const Entry& entry : entries) {
+        if (entry.name != "segment-trees" && entry.name != "range-tree") {
+            fail("--s-sweep takes segment-trees and range-tree only, got '" + entry.label + "'");
+        }
+    }
+    std::printf(
+        "S sweep: leaf width U = tuned scene extent / S; rejected = candidates the exact box "
+        "test turned down (the cost of quantisation)\n");
+    for (ThesisLayout layout : options.layouts) {
+        for (ThesisMotion motion : options.motions) {
+            for (int n : options.counts) {
+                kolize::ThesisSceneSettings sceneSettings;
+                sceneSettings.layout = layout;
+                sceneSettings.motion = motion;
+                sceneSettings.objects = n;
+                sceneSettings.seed = options.seed;
+                std::printf("\nscene %s, %s motion, N = %d, %d frames\n",
+                            kolize::layoutName(layout), kolize::motionName(motion), n,
+                            options.frames);
+                std::printf("| %-26s | %6s | %9s | %10s | %8s | %10s | %9s |\n", "broadphase", "S",
+                            "frame ms", "candidates", "pairs", "rejected", "rejected%");
+                std::printf("|%s|%s|%s|%s|%s|%s|%s|\n", std::string(28, '-').c_str(),
+                            std::string(8, '-').c_str(), std::string(11, '-').c_str(),
+                            std::string(12, '-').c_str(), std::string(10, '-').c_str(),
+                            std::string(12, '-').c_str(), std::string(11, '-').c_str());
+                for (const Entry& base : entries) {
+                    for (int divisions : options.sweep) {
+                        Entry entry = base;
+                        entry.settings.segmentTrees.cells.divisions = divisions;
+                        entry.settings.rangeTree.cells.divisions = divisions;
+                        progress("S sweep " + entry.label + " S=" + std::to_string(divisions));
+                        const Row row = run(entry, sceneSettings, options.frames);
+                        progress("");
+                        const std::size_t rejected =
+                            row.candidates > row.pairs ? row.candidates - row.pairs : 0;
+                        std::printf(
+                            "| %-26s | %6d | %9.4f | %10zu | %8zu | %10zu | %8.1f%% |\n",
+                            entry.label.c_str(), divisions, row.frameMs, row.candidates, row.pairs,
+                            rejected,
+                            row.candidates > 0 ? 100.0 * double(rejected) / row.candidates : 0.0);
+                    }
+                }
+                std::fflush(stdout);
+            }
+        }
+    }
+}
+
+/// One broadphase's frame times under slow and fast motion (thesis table 2.7).
+struct MotionPair {
+    ThesisLayout layout;
+    int n;
+    std::string label;
+    double slowMs = -1;
+    double fastMs = -1;
+};
+
+void printMotionTable(const std::vector<MotionPair>& pairs) {
+    std::printf(
+        "\nslow against fast motion (thesis table 2.7): frame ms, and fast / slow\n"
+        "| %-5s | %7s | %-26s | %9s | %9s | %9s |\n",
+        "scene", "N", "broadphase", "slow ms", "fast ms", "fast/slow");
+    std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(7, '-').c_str(), std::string(9, '-').c_str(),
+                std::string(28, '-').c_str(), std::string(11, '-').c_str(),
+                std::string(11, '-').c_str(), std::string(11, '-').c_str());
+    for (const MotionPair& pair : pairs) {
+        if (pair.slowMs < 0 || pair.fastMs < 0) {
+            continue;
+        }
+        std::printf("| %-5s | %7d | %-26s | %9.4f | %9.4f | %9.2f |\n",
+                    kolize::layoutName(pair.layout), pair.n, pair.label.c_str(), pair.slowMs,
+                    pair.fastMs, pair.slowMs > 0 ? pair.fastMs / pair.slowMs : 0.0);
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -342,6 +463,11 @@ int main(int argc, char** argv) {
         "kolize-bench: thesis scenes, Bullet %d, %s precision, seed %u; frame = setAabb "
         "x N + calculateOverlappingPairs; times are medians; errors in the last frame\n",
         btGetVersion(), sizeof(btScalar) == 8 ? "double" : "float", options.seed);
+    if (!options.sweep.empty()) {
+        sweepDivisions(options, entries);
+        return 0;
+    }
+    std::vector<MotionPair> motionPairs;
     for (ThesisLayout layout : options.layouts) {
         for (ThesisMotion motion : options.motions) {
             for (int n : options.counts) {
@@ -397,6 +523,17 @@ int main(int argc, char** argv) {
                             best > 0 ? row.frameMs / best : 0.0, row.pairs, row.missing, row.extra,
                             candidates, double(row.peakBytes) / (1024.0 * 1024.0));
                     }
+                    if (row.skipped.empty()) {
+                        auto same = [&](const MotionPair& pair) {
+                            return pair.layout == layout && pair.n == n && pair.label == row.label;
+                        };
+                        auto at = std::find_if(motionPairs.begin(), motionPairs.end(), same);
+                        if (at == motionPairs.end()) {
+                            at = motionPairs.insert(motionPairs.end(),
+                                                    MotionPair{layout, n, row.label});
+                        }
+                        (motion == ThesisMotion::Slow ? at->slowMs : at->fastMs) = row.frameMs;
+                    }
                     if (csv != nullptr) {
                         std::fprintf(csv, "%s,%s,%d,%s,%s,%.6f,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu\n",
                                      kolize::layoutName(layout), kolize::motionName(motion), n,
@@ -408,6 +545,9 @@ int main(int argc, char** argv) {
                 std::fflush(stdout);
             }
         }
+    }
+    if (options.motions.size() > 1) {
+        printMotionTable(motionPairs);
     }
     if (csv != nullptr) {
         std::fclose(csv);
