@@ -12,7 +12,8 @@
 /// validate(): every live object's cell box is exactly clamp(cells(box), windows).
 ///
 /// Tuning: the first insert, every insert that doubles the live count since the last
-/// tuning, and the first findCandidates after the count grew by a quarter recompute U
+/// tuning, the first findCandidates, and any later one after the count grew by a quarter
+/// recompute U
 /// (tuneScene); when it changed, the trees are rebuilt. That is amortised O(log N) per
 /// insert and keeps U fitted to a scene that is built up over time.
 
@@ -298,11 +299,14 @@ class CellCore {
         changesOverflowed_ = false;
     }
 
-    /// Called by the derived core before finding pairs: retunes when the live count has
-    /// grown by a quarter since the last tuning (a scene loaded object by object gets the
-    /// U of the whole scene at its first frame). Amortised O(1) per insert.
+    /// Called by the derived core before finding pairs: retunes at the first frame (a
+    /// scene loaded object by object gets the U of the whole scene, not of the first half
+    /// it saw) and whenever the live count has grown by a quarter since the last tuning.
+    /// Amortised O(1) per insert.
     void retuneBeforeFrame() {
-        if (live_.size() >= 2 && live_.size() * 4 >= tunedCount_ * 5) {
+        const bool first = !sawFrame_ && live_.size() != tunedCount_;
+        sawFrame_ = true;
+        if (live_.size() >= 2 && (first || live_.size() * 4 >= tunedCount_ * 5)) {
             retune();
         }
     }
@@ -665,6 +669,7 @@ class CellCore {
     CellTuning tuning_;
     CellQuantizer quantizer_;
     bool built_ = false;
+    bool sawFrame_ = false;
     std::size_t tunedCount_ = 0;
     std::vector<Box> boxes_;
     std::vector<CellBox<D>> cells_;

@@ -312,6 +312,18 @@ class SegmentTree {
         }
     }
 
+    /// The cell range object `id` is stored with (its nodes tile it); false when it is not
+    /// stored.
+    bool storedRange(ObjectId id, std::int64_t& lo, std::int64_t& hi) const {
+        if (id >= refs_.size() || refs_[id].size() == 0) {
+            return false;
+        }
+        const RefList& refs = refs_[id];
+        lo = nodes_[refs[0].node].first;
+        hi = nodes_[refs[refs.size() - 1].node].last();
+        return true;
+    }
+
     /// How many nodes hold entries of object `id` (0 when it is not stored).
     std::size_t entryCount(ObjectId id) const { return id < refs_.size() ? refs_[id].size() : 0; }
 

@@ -18,9 +18,12 @@
 ///   updated from the objects whose cell box changed (see CellCore), which is most frames
 ///   when motion is slow relative to the leaf width.
 ///
-/// Updates: an object whose cell box keeps its place costs a quantisation; one that changes
-/// range on an axis is moved in that axis's tree from the lowest node covering its new
-/// range. Unbounded (see CellCore): trees grow to cover any object within +-kCellLimit cells
+/// Updates: an object whose cell box keeps its place costs a few comparisons; one that
+/// changes range on an axis is moved in that axis's tree from the lowest node covering its
+/// new range. With Stabbing, only the stabbing axis's tree is consulted each frame, so only
+/// it is kept current; the other trees note which objects they owe an update and catch up
+/// when their axis becomes the stabbing axis (with ThesisFlags all trees stay current).
+/// Unbounded (see CellCore): trees grow to cover any object within +-kCellLimit cells
 /// of the origin, so nothing is ever dropped; a +-1e18 plane is clamped to the root's range
 /// and sits in the root, a candidate with everything, which is what it is.
 
@@ -63,7 +66,7 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     }
 
     /// Calls `visit(id)` once for every live object whose cell box overlaps the cells of
-    /// `box`. Walks one tree, on the axis where the query is narrowest.
+    /// `box`. Walks one current tree (the narrowest axis of the query among them).
     template <class Visit>
     void queryBox(const Box& box, Visit&& visit) const {
         if (this->size() > 0) {
@@ -78,13 +81,30 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
             return;
         }
         for (int axis = 0; axis < D; ++axis) {
+            const std::string what = "SegmentTreeSet axis " + std::to_string(axis);
+            const std::vector<std::uint8_t>& owed = owed_[axis];
+            for (ObjectId id : owedList_[axis]) {
+                if (id >= owed.size() || !owed[id]) {
+                    throw std::logic_error(what + ": owed list and flags disagree");
+                }
+            }
+            if (current(axis) && !owedList_[axis].empty()) {
+                throw std::logic_error(what + ": a current tree owes updates");
+            }
+            const auto cellRange = this->storedRangeOn(axis);
             trees_[axis].validate(
-                "SegmentTreeSet axis " + std::to_string(axis), this->live().size(),
-                this->storedRangeOn(axis), [&](const Entry& e, Index) {
+                what, this->live().size(),
+                [&](ObjectId id, std::int64_t& lo, std::int64_t& hi) {
+                    // An object the tree owes an update is where it was: check the structure.
+                    return id < owed.size() && owed[id] && this->isLive(id)
+                               ? trees_[axis].storedRange(id, lo, hi)
+                               : cellRange(id, lo, hi);
+                },
+                [&](const Entry& e, Index) {
                     const Entry expected = cellEntry<D>(e.id, this->cells(e.id), axis);
-                    if (expected.other != e.other) {
-                        throw std::logic_error("SegmentTreeSet axis " + std::to_string(axis) +
-                                               ": stale entry of object " + std::to_string(e.id));
+                    if (!(e.id < owed.size() && owed[e.id]) && expected.other != e.other) {
+                        throw std::logic_error(what + ": stale entry of object " +
+                                               std::to_string(e.id));
                     }
                 });
         }
@@ -95,8 +115,9 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         std::size_t bytes = this->objectMemoryBytes() +
                             (stampOf_.capacity() * sizeof(std::uint32_t)) + flags_.capacity() +
                             flat_.capacity() * sizeof(Cell) + path_.capacity() * sizeof(Span);
-        for (const Tree& tree : trees_) {
-            bytes += tree.memoryBytes();
+        for (int axis = 0; axis < D; ++axis) {
+            bytes += trees_[axis].memoryBytes() + owed_[axis].capacity() +
+                     owedList_[axis].capacity() * sizeof(ObjectId);
         }
         return bytes;
     }
@@ -136,8 +157,42 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     void resetTrees(const CellBox<D>& root) {
         for (int axis = 0; axis < D; ++axis) {
             trees_[axis].reset(root.lo[axis], levelCovering(root.lo[axis], root.hi[axis]));
+            for (ObjectId id : owedList_[axis]) {
+                owed_[axis][id] = 0;
+            }
+            owedList_[axis].clear();
         }
         frame_ = 0;
+    }
+
+    /// Whether the tree on `axis` is kept current (else it notes what it owes).
+    bool current(int axis) const {
+        return settings_.traversal == Settings::Traversal::ThesisFlags || axis == axis_;
+    }
+
+    /// Brings object `id`'s entries on `axis` to its cell box.
+    void refresh(int axis, ObjectId id) {
+        const CellBox<D>& cells = this->cells(id);
+        const Entry fresh = cellEntry<D>(id, cells, axis);
+        std::int64_t lo = 0, hi = 0;
+        trees_[axis].storedRange(id, lo, hi);
+        if (lo != cells.lo[axis] || hi != cells.hi[axis]) {
+            trees_[axis].move(id, cells.lo[axis], cells.hi[axis], fresh, [](Index) {});
+        } else {
+            // Same nodes; refresh the other axes the entries carry.
+            trees_[axis].editEntries(id, [&](Entry& e, Index) { e = fresh; });
+        }
+    }
+
+    /// Makes the tree on `axis` current: the updates it owes.
+    void catchUp(int axis) {
+        for (ObjectId id : owedList_[axis]) {
+            owed_[axis][id] = 0;
+            if (this->isLive(id)) {
+                refresh(axis, id);
+            }
+        }
+        owedList_[axis].clear();
     }
 
     void store(ObjectId id) {
@@ -154,25 +209,30 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         }
     }
 
-    void restore(ObjectId id, const CellBox<D>& old) {
-        const CellBox<D>& cells = this->cells(id);
+    void restore(ObjectId id, const CellBox<D>&) {
         for (int axis = 0; axis < D; ++axis) {
-            const Entry fresh = cellEntry<D>(id, cells, axis);
-            if (cells.lo[axis] != old.lo[axis] || cells.hi[axis] != old.hi[axis]) {
-                trees_[axis].move(id, cells.lo[axis], cells.hi[axis], fresh, [](Index) {});
+            if (current(axis)) {
+                if (!(id < owed_[axis].size() && owed_[axis][id])) {
+                    refresh(axis, id);
+                }
             } else {
-                // Same nodes; refresh the other axes the entries carry.
-                trees_[axis].editEntries(id, [&](Entry& e, Index) { e = fresh; });
+                if (id >= owed_[axis].size()) {
+                    owed_[axis].resize(id + 1, 0);
+                }
+                if (!owed_[axis][id]) {
+                    owed_[axis][id] = 1;
+                    owedList_[axis].push_back(id);
+                }
             }
         }
     }
 
     template <class Visit>
     void visitCells(const CellBox<D>& query, Visit&& visit) const {
-        int axis = 0;
-        for (int a = 1; a < D; ++a) {
-            if (std::int64_t(query.hi[a]) - query.lo[a] <
-                std::int64_t(query.hi[axis]) - query.lo[axis]) {
+        int axis = axis_;
+        for (int a = 0; a < D; ++a) {
+            if (current(a) && std::int64_t(query.hi[a]) - query.lo[a] <
+                                  std::int64_t(query.hi[axis]) - query.lo[axis]) {
                 axis = a;
             }
         }
@@ -339,14 +399,17 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
     /// cells below (each first cell's path scans the node). O(nodes) per axis.
     void chooseAxis() {
         std::int64_t best = -1;
+        int choice = axis_;
         for (int axis = 0; axis < D; ++axis) {
             std::int64_t work = 0;
             firstsBelow(trees_[axis], trees_[axis].root(), work);
             if (best < 0 || work < best) {
                 best = work;
-                axis_ = axis;
+                choice = axis;
             }
         }
+        catchUp(choice);
+        axis_ = choice;
     }
 
     static std::int64_t firstsBelow(const Tree& tree, Index at, std::int64_t& work) {
@@ -405,6 +468,10 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
 
     Settings settings_;
     std::array<Tree, D> trees_;
+    /// Per axis, objects whose entries in that (not current) tree are out of date: a flag
+    /// per object and their list.
+    std::array<std::vector<std::uint8_t>, D> owed_;
+    std::array<std::vector<ObjectId>, D> owedList_;
     int axis_ = 0;
     unsigned frame_ = 0;
     std::vector<Cell> flat_;
