@@ -66,14 +66,6 @@ struct Options {
     std::string csv;
 };
 
-std::string joinedNames() {
-    std::string out;
-    for (const std::string& name : kolize::broadphaseNames()) {
-        out += (out.empty() ? "" : ", ") + name;
-    }
-    return out;
-}
-
 [[noreturn]] void fail(const std::string& message) {
     std::fprintf(stderr, "kolize-bench: %s (try --help)\n", message.c_str());
     std::exit(2);
@@ -112,7 +104,7 @@ Entry parseEntry(const std::string& text) {
     entry.name = parts.empty() ? "" : parts[0];
     const auto& names = kolize::broadphaseNames();
     if (std::find(names.begin(), names.end(), entry.name) == names.end()) {
-        fail("unknown broadphase '" + entry.name + "'; valid: " + joinedNames());
+        fail("unknown broadphase '" + entry.name + "'; valid: " + kolize::broadphaseNameList());
     }
     for (std::size_t i = 1; i < parts.size(); ++i) {
         const std::vector<std::string> keyValue = split(parts[i], '=');
@@ -144,7 +136,7 @@ Options parse(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
         if (flag == "--help" || flag == "-h") {
-            std::printf(kUsage, joinedNames().c_str());
+            std::printf(kUsage, kolize::broadphaseNameList().c_str());
             std::exit(0);
         }
         if (i + 1 >= argc) {

@@ -261,9 +261,10 @@ int main(int argc, char** argv) {
         {"brute-force", runKolize<kolize::BruteForce<2, double>>},
         {"box2d", runBox2d},
     };
-    std::printf("kolize-bench-2d: 2D thesis scenes, seed %u; frame = update every object + "
-                "pair set; medians; errors against the exact pairs in the last frame\n",
-                seed);
+    std::printf(
+        "kolize-bench-2d: 2D thesis scenes, seed %u; frame = update every object + "
+        "pair set; medians; errors against the exact pairs in the last frame\n",
+        seed);
     for (ThesisLayout layout : layouts) {
         for (ThesisMotion motion : motions) {
             for (int n : counts) {
@@ -279,13 +280,15 @@ int main(int argc, char** argv) {
                     truthScene.step();
                 }
                 const std::vector<std::uint64_t> truth = exactPairs(truthScene.boxes());
-                std::printf("\n2D scene %s, %s motion, N = %d, %d frames (ratio: frame time / "
-                            "Box2D's)\n",
-                            kolize::layoutName(layout), kolize::motionName(motion), n, runFrames);
+                std::printf(
+                    "\n2D scene %s, %s motion, N = %d, %d frames (ratio: frame time / "
+                    "Box2D's)\n",
+                    kolize::layoutName(layout), kolize::motionName(motion), n, runFrames);
                 std::printf("| %-13s | %9s | %9s | %6s | %8s | %7s | %7s |\n", "broadphase",
                             "init ms", "frame ms", "ratio", "pairs", "missing", "extra");
-                std::printf("|---------------|-----------|-----------|--------|----------|-------"
-                            "--|---------|\n");
+                std::printf(
+                    "|---------------|-----------|-----------|--------|----------|-------"
+                    "--|---------|\n");
                 std::map<std::string, Result> results;
                 for (const auto& [name, runner] : runners) {
                     if (name == "brute-force" && n > 20000) {
@@ -306,9 +309,8 @@ int main(int argc, char** argv) {
                     std::set_difference(result.pairs.begin(), result.pairs.end(), truth.begin(),
                                         truth.end(), std::back_inserter(extra));
                     std::printf("| %-13s | %9.3f | %9.4f | %6.3f | %8zu | %7zu | %7zu |\n",
-                                name.c_str(), result.initMs, result.frameMs,
-                                result.frameMs / box2d, result.pairs.size(), missing.size(),
-                                extra.size());
+                                name.c_str(), result.initMs, result.frameMs, result.frameMs / box2d,
+                                result.pairs.size(), missing.size(), extra.size());
                 }
                 std::fflush(stdout);
             }
