@@ -1,5 +1,7 @@
 #include "kolize/narrowphase/ccd.h"
 
+#include "ccd_exact.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -211,6 +213,7 @@ std::array<double, 3> crossAt(const std::array<std::array<double, 3>, 4>& x0,
 /// Vertex-face: F = (p - a) - u (b - a) - v (c - a), all at time t.
 struct VertexFaceF {
     static constexpr bool kTriangleDomain = true;
+    static constexpr auto kExact = detail::vertexFaceExact;
     /// Face normal at time t (any direction is valid for exclusion; this one is the
     /// direction in which a near-coplanar F image is thin).
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
@@ -242,6 +245,7 @@ struct VertexFaceF {
 /// Edge-edge: F = (a0 + u (a1 - a0)) - (b0 + v (b1 - b0)), all at time t.
 struct EdgeEdgeF {
     static constexpr bool kTriangleDomain = false;
+    static constexpr auto kExact = detail::edgeEdgeExact;
     /// Common normal of both edges at time t.
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
                                         const std::array<std::array<double, 3>, 4>& dx, double t) {
@@ -315,6 +319,13 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     // [t0, t1], so boxes keep covering [0, max_time] without dyadic end points.
     queue.push({0.0, std::clamp(settings.max_time, 0.0, 1.0), 0.0, 1.0, 0.0, 1.0, 0});
     Corners f;
+    auto decideExactly = [&](double t0) {
+        const detail::ExactContact exact = Evaluator::kExact(
+            start, end, t0, std::clamp(settings.max_time, 0.0, 1.0), settings.toi_tolerance);
+        result.hit = exact.hit;
+        result.toi = exact.hit ? exact.toi : 1.0;
+        return result;
+    };
     while (!queue.empty()) {
         const Box b = queue.top();
         queue.pop();
@@ -322,10 +333,8 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             continue;  // Entirely outside u + v <= 1 (the sum of dyadics is exact).
         }
         if (++result.boxes > settings.max_boxes) {
-            result.hit = true;  // Conservative: b.t0 is the earliest unresolved time.
-            result.toi = b.t0;
             result.budget_exhausted = true;
-            return result;
+            return decideExactly(b.t0);
         }
         evaluate(x0, dx, b, f);
         bool excluded = false;
@@ -352,9 +361,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         if (within_tolerance && time_resolved) {
             // Every point of b is within tolerance + 2 eps of a root in max norm, and
             // b.t0 is no later than any box still queued, hence than the true toi.
-            result.hit = true;
-            result.toi = b.t0;
-            return result;
+            return decideExactly(b.t0);
         }
         // Split the dimension along which F varies most (largest change between the
         // corner pairs that differ only in that dimension). Time is favoured (x4): a
@@ -388,10 +395,8 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         if (variation[d] < 0.0) {
             // Cannot split further without losing exactness: accept conservatively, like
             // an exhausted budget (the tolerance bound does not apply to this answer).
-            result.hit = true;
             result.budget_exhausted = true;
-            result.toi = b.t0;
-            return result;
+            return decideExactly(b.t0);
         }
         Box lo = b, hi = b;
         lo.depth = hi.depth = b.depth + 1;
