@@ -9,6 +9,13 @@
 #include <queue>
 #include <vector>
 
+#ifdef KOLIZE_EXACT_STATS
+#include <chrono>
+namespace kolize::ccd::detail {
+extern double exactSeconds;
+extern int exactCalls;
+}  // namespace kolize::ccd::detail
+#endif
 namespace kolize::ccd {
 namespace {
 
@@ -320,6 +327,16 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     queue.push({0.0, std::clamp(settings.max_time, 0.0, 1.0), 0.0, 1.0, 0.0, 1.0, 0});
     Corners f;
     auto decideExactly = [&](double t0) {
+#ifdef KOLIZE_EXACT_STATS
+        struct Timer {
+            std::chrono::steady_clock::time_point s = std::chrono::steady_clock::now();
+            ~Timer() {
+                detail::exactSeconds +=
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - s).count();
+                ++detail::exactCalls;
+            }
+        } timer;
+#endif
         const detail::ExactContact exact = Evaluator::kExact(
             start, end, t0, std::clamp(settings.max_time, 0.0, 1.0), settings.toi_tolerance);
         result.hit = exact.hit;
@@ -358,7 +375,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             continue;
         }
         const bool time_resolved = b.t1 - b.t0 <= settings.toi_tolerance || b.t1 - b.t0 < kMinWidth;
-        if (within_tolerance && time_resolved) {
+        if (within_tolerance) {
             // Every point of b is within tolerance + 2 eps of a root in max norm, and
             // b.t0 is no later than any box still queued, hence than the true toi.
             return decideExactly(b.t0);
