@@ -1,15 +1,14 @@
 #include "ccd_exact.h"
 
 #include <gmp.h>
-#include <chrono>
 
 #include <algorithm>
-#include <initializer_list>
 #include <cassert>
+#include <cfenv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <cfenv>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <type_traits>
@@ -26,25 +25,30 @@
 //   time where contact *begins*. Contact of a vertex with the relative interior of a
 //   non-degenerate triangle, or of two non-parallel edges crossing at interior points, is
 //   open in time while the motion stays coplanar, so it cannot begin at t > a: contact
-//   begins on a closed edge -- a vertex reaching an edge's line (a common root of the
-//   components of (p - x) x (y - x), unless they vanish identically, in which case the
-//   vertex can only enter the edge through an end point) or a vertex meeting a vertex (a
-//   common root of the components of p - x). Those times, and a, are the candidates.
+//   begins on a closed edge -- a vertex reaching an edge's line (a root of a component of
+//   (p - x) x (y - x) that is not identically zero; if all are, the vertex stays on the
+//   line and can only enter the edge through an end point) or a vertex meeting a vertex (a
+//   root of a component of p - x). Those times, and a, are the candidates; the static test
+//   rejects the ones that are not contacts.
 //
 // A candidate time t* is a rational num / den, or the only root of a squarefree polynomial p
-// in an interval (lo, hi) with dyadic ends, isolated with Sturm sequences. The static test
-// evaluates signs of polynomials g at t*: homogeneously for a rational, and for a root by a
-// Tarski query: sign g(t*) = Var(lo) - Var(hi) of the signed remainder sequence of
-// (p, p' g mod p), which also decides g(t*) = 0. Nothing divides: remainders are pseudo-
-// remainders scaled by positive factors, which keeps every sign and every root.
+// in an interval (lo, hi) with dyadic ends. The static test evaluates signs of polynomials
+// g at t*: homogeneously for a rational; for a root, first by bounding g over (lo, hi)
+// while halving it a few times, then by a Tarski query: sign g(t*) = Var(lo) - Var(hi) of
+// the signed remainder sequence of (p, p' g mod p), which also decides g(t*) = 0. Nothing
+// divides: remainders are pseudo-remainders scaled by positive factors, which keeps every
+// sign and every root.
 //
-// Arithmetic: the same code runs first on double intervals with directed rounding
-// (emulated with error-free transformations, so results computed without rounding stay
-// exact points). Every branch asks for a sign; an interval that straddles zero throws
-// `Uncertain`, and only then the query is redone with exact dyadic numbers (GMP integers
-// times powers of two). Interval answers are exact answers, just cheaper; the exact numbers
-// are needed for true degeneracies (contact exactly on a boundary, exact double roots) and
-// for near-misses closer than double intervals can resolve.
+// Arithmetic: the same code runs first on double intervals, with the FPU rounding upward
+// (results computed without rounding stay exact points, so exact zeros often survive).
+// Every branch asks for a sign; an interval that straddles zero throws `Uncertain`, and
+// only then the query is redone with exact dyadic numbers (GMP integers times powers of
+// two), which still try intervals around their exact values before each exact sign. The
+// interval pass isolates roots by Bernstein subdivision, which never divides by a
+// coefficient (a nearly vanishing lead costs it nothing); the exact pass by Sturm
+// sequences. Interval answers are exact answers, just cheaper; the exact numbers are
+// needed for true degeneracies (contact exactly on a boundary, exact double roots) and for
+// near-misses closer than double intervals can resolve.
 
 namespace kolize::ccd::detail {
 namespace {
@@ -79,16 +83,22 @@ double nextDown(double x) {
 // operation. Overflow rounds to infinity on the safe side; an infinite bound is refused
 // before it can meet a zero (inf * 0 or inf - inf would be NaN).
 
-/// Sets the FPU to round upward for the lifetime of the object, then restores the mode.
+/// Rounds upward for the lifetime of the object, from the default environment (so no
+/// flush-to-zero or denormals-are-zero mode a caller may have set, under which bounds of
+/// tiny values would collapse to zero), then restores the caller's environment.
 class UpwardRounding {
   public:
-    UpwardRounding() : saved_(std::fegetround()) { std::fesetround(FE_UPWARD); }
-    ~UpwardRounding() { std::fesetround(saved_); }
+    UpwardRounding() {
+        std::fegetenv(&saved_);
+        std::fesetenv(FE_DFL_ENV);
+        std::fesetround(FE_UPWARD);
+    }
+    ~UpwardRounding() { std::fesetenv(&saved_); }
     UpwardRounding(const UpwardRounding&) = delete;
     UpwardRounding& operator=(const UpwardRounding&) = delete;
 
   private:
-    int saved_;
+    std::fenv_t saved_;
 };
 
 /// A closed interval of doubles containing the exact value.
@@ -1298,48 +1308,32 @@ template <class N>
 }
 
 }  // namespace
-#ifdef KOLIZE_EXACT_STATS
-int exactFallbacks = 0;
-double exactSeconds = 0;
-double fallbackSeconds = 0;
-struct FallbackTimer {
-    std::chrono::steady_clock::time_point s = std::chrono::steady_clock::now();
-    ~FallbackTimer() {
-        fallbackSeconds +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - s).count();
-    }
-};
-int exactCalls = 0;
-#endif
 
 ExactContact vertexFaceExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
-                             double t_lo, double t_hi, double toi_tolerance) {
+                             double t_lo, double t_hi, double toi_tolerance,
+                             Arithmetic arithmetic) {
     // Both passes need upward rounding (the exact one filters with intervals too); they are
     // not inlined, so no floating-point operation can move across the mode switch.
     const UpwardRounding upward;
-    try {
-        return vertexFace<Interval>(start, end, t_lo, t_hi, toi_tolerance);
-    } catch (const Uncertain&) {
-#ifdef KOLIZE_EXACT_STATS
-        ++exactFallbacks;
-        FallbackTimer timer;
-#endif
-        return vertexFace<Dyadic>(start, end, t_lo, t_hi, toi_tolerance);
+    if (arithmetic == Arithmetic::kFiltered) {
+        try {
+            return vertexFace<Interval>(start, end, t_lo, t_hi, toi_tolerance);
+        } catch (const Uncertain&) {
+        }
     }
+    return vertexFace<Dyadic>(start, end, t_lo, t_hi, toi_tolerance);
 }
 
 ExactContact edgeEdgeExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
-                           double t_lo, double t_hi, double toi_tolerance) {
+                           double t_lo, double t_hi, double toi_tolerance, Arithmetic arithmetic) {
     const UpwardRounding upward;
-    try {
-        return edgeEdge<Interval>(start, end, t_lo, t_hi, toi_tolerance);
-    } catch (const Uncertain&) {
-#ifdef KOLIZE_EXACT_STATS
-        ++exactFallbacks;
-        FallbackTimer timer;
-#endif
-        return edgeEdge<Dyadic>(start, end, t_lo, t_hi, toi_tolerance);
+    if (arithmetic == Arithmetic::kFiltered) {
+        try {
+            return edgeEdge<Interval>(start, end, t_lo, t_hi, toi_tolerance);
+        } catch (const Uncertain&) {
+        }
     }
+    return edgeEdge<Dyadic>(start, end, t_lo, t_hi, toi_tolerance);
 }
 
 }  // namespace kolize::ccd::detail
