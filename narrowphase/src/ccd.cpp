@@ -315,10 +315,11 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     const Evaluator evaluate;
     CcdResult result;
     const double t_max = std::clamp(settings.max_time, 0.0, 1.0);
+    const double t_min = std::clamp(settings.min_time, 0.0, t_max);
     std::priority_queue<Box, std::vector<Box>, LaterBox> queue;
     // Any double t is evaluated exactly as given, and a rounded midpoint still lies in
-    // [t0, t1], so boxes keep covering [0, max_time] without dyadic end points.
-    queue.push({0.0, t_max, 0.0, 1.0, 0.0, 1.0, 0});
+    // [t0, t1], so boxes keep covering [min_time, max_time] without dyadic end points.
+    queue.push({t_min, t_max, 0.0, 1.0, 0.0, 1.0, 0});
     Corners f;
     // Boxes are examined in order of t0 and every box before was excluded, so no contact
     // happens before t0: the exact decision only needs [t0, max_time].

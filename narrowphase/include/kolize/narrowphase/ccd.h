@@ -54,10 +54,11 @@
 ///   Guarantee, for inputs whose coordinates are finite doubles with magnitude at most
 ///   kMaxCoordinate (stage 1's error bound must not overflow; stage 2 has no limit):
 ///   - exact: `hit` is true if and only if the closed primitives touch at some t in
-///     [0, max_time] -- no false negatives and no false positives, whatever `tolerance`;
+///     [min_time, max_time] (default [0, 1]) -- no false negatives and no false
+///     positives, whatever `tolerance`;
 ///   - time of impact: when `hit`, `toi` <= t* <= `toi` + `toi_tolerance` (plus one
-///     rounding to double), where t* is the earliest contact time: never late, so moving
-///     the objects back to `toi` never leaves them interpenetrating.
+///     rounding to double), where t* is the earliest contact time in that range: never
+///     late, so moving the objects back to `toi` never leaves them interpenetrating.
 #include <Eigen/Core>
 
 #include <array>
@@ -117,9 +118,11 @@ struct RobustSettings {
     /// The reported `toi` is at most this much earlier than the true first contact (and
     /// never later).
     double toi_tolerance = 1e-6;
-    /// Only contacts at t <= max_time (in (0, 1]) are searched: the guarantees hold on
-    /// [0, max_time], later contacts are ignored. Lets a caller that already knows an
-    /// earlier contact (e.g. meshCcd) skip work.
+    /// Only contacts at t in [min_time, max_time] (within [0, 1]) are searched: the
+    /// guarantees hold on that range, contacts outside it are ignored. Lets a caller that
+    /// already knows an earlier contact, or splits the step into time slices (meshCcd),
+    /// skip work.
+    double min_time = 0.0;
     double max_time = 1.0;
     /// Box budget of the floating-point stage; when it runs out the exact stage decides.
     /// Bounds the stage's worst-case work; never changes the answer.
