@@ -158,7 +158,8 @@ CcdResult cubicCcd(const Query& q, const std::array<Vec3, 3>& x0, const std::arr
 }
 
 // ---------------------------------------------------------------------------------------
-// Robust method: conservative inclusion-based root finding over (t, u, v).
+// Robust method, stage 1: conservative inclusion search over (t, u, v) that only excludes;
+// stage 2, the exact decision, is in ccd_exact.cpp.
 // ---------------------------------------------------------------------------------------
 
 /// Forward error bound factor. Evaluating F at a box corner (t, u, v exact dyadic numbers)
@@ -184,8 +185,9 @@ struct Box {
     int depth;
 };
 
-/// Heap order: earliest t0 first (this is what makes the reported toi conservative),
-/// then the deepest box (dive towards an answer instead of widening the front).
+/// Heap order: earliest t0 first (so when a box is handed to the exact stage, no contact
+/// happens before its t0), then the deepest box (dive towards an answer instead of
+/// widening the front).
 struct LaterBox {
     bool operator()(const Box& a, const Box& b) const {
         if (a.t0 != b.t0) {
