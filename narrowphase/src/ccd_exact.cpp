@@ -13,7 +13,6 @@
 #include <optional>
 #include <type_traits>
 #include <utility>
-#include <vector>
 
 // Why this decomposition is complete. Every vertex moves linearly, so every quantity below
 // is a polynomial in t whose coefficients are exact sums of products of the input doubles.
@@ -370,10 +369,10 @@ class Dyadic {
             mpn_sub(rp, rp, n, low.data(), low.size_);
             r.negative_ = high_negative;
         } else {
-            // |low| > |shifted high|: low - shifted high, both widened to n limbs.
-            std::vector<mp_limb_t> widened(low.data(), low.data() + low.size_);
-            widened.resize(n, 0);
-            mpn_sub_n(rp, widened.data(), rp, n);
+            // |low| > |shifted high|, so shifted high < 2^(64 low.size_): subtract it from
+            // low on low.size_ limbs (mpn_sub_n may write over its second operand).
+            mpn_sub_n(rp, low.data(), rp, low.size_);
+            std::fill(rp + low.size_, rp + n, mp_limb_t(0));
             r.negative_ = low_negative;
         }
         r.size_ = stripped(rp, n);
