@@ -238,6 +238,37 @@ TEST(CcdLargeCoordinates, BothKindsFrom1e4To1e6) {
     }
 }
 
+TEST(CcdEdgeEdge, TangentialContactIsADoubleRoot) {
+    // A lies on the x axis. B turns about it: b0 = (0, t - 1/2, 1), b1 = (0, 0, t - 1/2),
+    // so the coplanarity polynomial is 2 (t - 1/2)^2, a double root, where B's end b1
+    // touches A at the origin and leaves again. Starting A at x = 2^-40 instead misses.
+    const EdgeEdgeQuery touch{{Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -0.5, 1), Vec3(0, 0, -0.5)},
+                              {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, 0.5, 1), Vec3(0, 0, 0.5)}};
+    expectRobustHit(edgeEdgeRobust(touch), 0.5);
+    EdgeEdgeQuery miss = touch;
+    miss.start[0].x() = miss.end[0].x() = 0x1p-40;
+    EXPECT_FALSE(edgeEdgeRobust(miss).hit);
+}
+
+TEST(CcdLargeCoordinates, TinyAndHugeScalesStayExact) {
+    // Scaled by 1e-150 every product in the exact stage underflows the double intervals,
+    // by 1e100 they overflow: both must fall back to exact arithmetic, not give up.
+    for (double s : {1e-150, 1e100}) {
+        SCOPED_TRACE(s);
+        const auto hit = pointVsTriangle(Vec3(0.25, 0.25, 1) * s, Vec3(0.25, 0.25, -1) * s);
+        VertexFaceQuery scaled = hit;
+        for (auto* side : {&scaled.start, &scaled.end}) {
+            for (int i = 1; i < 4; ++i) {
+                (*side)[i] *= s;
+            }
+        }
+        expectRobustHit(vertexFaceRobust(scaled), 0.5);
+        VertexFaceQuery beside = scaled;
+        beside.start[0].x() = beside.end[0].x() = -0x1p-40 * s;  // just off edge ca
+        EXPECT_FALSE(vertexFaceRobust(beside).hit);
+    }
+}
+
 TEST(CcdEdgeEdge, HourglassPinch) {
     // The hourglass: A's endpoints swap places through each other, so A's swept ruled
     // surface is two triangles (|x| <= |z| in the plane y = 0) pinched at the origin, where
