@@ -488,7 +488,8 @@ std::optional<Interval> toInterval(const Dyadic& x) {
 
 constexpr int kMaxTerms = 5;
 
-/// c[0] + c[1] t + ... + c[n - 1] t^(n - 1) with c[n - 1] != 0; n = 0: the zero polynomial.
+/// c[0] + c[1] t + ... + c[n - 1] t^(n - 1); c[n - 1] is not (certainly) zero, see trim();
+/// n = 0: the zero polynomial.
 template <class N>
 struct Poly {
     std::array<N, kMaxTerms> c;
@@ -1048,11 +1049,6 @@ PolyVec<N> offset(const Vec3& i0, const Vec3& i1, const Vec3& j0, const Vec3& j1
         trim(r[k]);
     }
     return r;
-}
-
-template <class N>
-PolyVec<N> operator-(const PolyVec<N>& a, const PolyVec<N>& b) {
-    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
 
 template <class N>
