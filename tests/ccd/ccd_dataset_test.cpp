@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <stdexcept>
 #include <string>
 
@@ -102,6 +103,60 @@ TEST(CcdDataset, FilteredExactOnlyAndTwoStageDecisionsAgree) {
             }
         }
     }
+}
+
+// The same agreement on random queries built to be degenerate: coordinates on a coarse
+// grid of halves (so coplanar motion, parallel edges, shared points and exact touches are
+// common and the filter often meets exact zeros), some nudged by a few units in the last
+// place (near-misses the filter cannot resolve).
+TEST(CcdRandomDegenerate, FilteredExactOnlyAndTwoStageDecisionsAgree) {
+    const unsigned seed = 5;
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> grid(-4, 4), nudge(-3, 3), coin(0, 3);
+    auto coordinate = [&] {
+        double x = 0.5 * grid(rng);
+        if (coin(rng) == 0) {
+            x += nudge(rng) * 0x1p-52;
+        }
+        return x;
+    };
+    auto point = [&] { return Vec3(coordinate(), coordinate(), coordinate()); };
+    const RobustSettings settings;
+    const double slack = settings.toi_tolerance + 1e-15;
+    int hits = 0;
+    const int trials = 3000;
+    for (int trial = 0; trial < trials; ++trial) {
+        SCOPED_TRACE("seed " + std::to_string(seed) + ", trial " + std::to_string(trial));
+        LabeledQuery q;
+        for (int i = 0; i < 4; ++i) {
+            q.start[i] = point();
+            // Often a vertex keeps still or shares its motion with the previous one.
+            const int motion = coin(rng);
+            q.end[i] = motion == 0            ? q.start[i]
+                       : motion == 1 && i > 0 ? q.start[i] + (q.end[i - 1] - q.start[i - 1])
+                                              : point();
+        }
+        const QueryKind kind = trial % 2 ? QueryKind::kEdgeEdge : QueryKind::kVertexFace;
+        auto exact = [&](detail::Arithmetic arithmetic) {
+            return kind == QueryKind::kVertexFace
+                       ? detail::vertexFaceExact(q.start, q.end, 0.0, 1.0, settings.toi_tolerance,
+                                                 arithmetic)
+                       : detail::edgeEdgeExact(q.start, q.end, 0.0, 1.0, settings.toi_tolerance,
+                                               arithmetic);
+        };
+        const detail::ExactContact filtered = exact(detail::Arithmetic::kFiltered);
+        const detail::ExactContact exact_only = exact(detail::Arithmetic::kExactOnly);
+        const CcdResult two_stage = robustQuery(kind, q, settings);
+        ASSERT_EQ(exact_only.hit, filtered.hit);
+        ASSERT_EQ(two_stage.hit, filtered.hit);
+        if (filtered.hit) {
+            EXPECT_NEAR(exact_only.toi, filtered.toi, slack);
+            EXPECT_NEAR(two_stage.toi, filtered.toi, slack);
+        }
+        hits += filtered.hit;
+    }
+    EXPECT_GT(hits, trials / 10) << "seed " << seed;
+    EXPECT_LT(hits, trials * 9 / 10) << "seed " << seed;
 }
 
 }  // namespace
