@@ -39,7 +39,7 @@ done
 gnuplot <<GNUPLOT
 set terminal pngcairo size 1200,500 noenhanced
 set output "$out/sweep.png"
-set multiplot layout 1,2 title "CCD tolerance sweep 1e-8 ... 1e-1 over all queries: error against run time (one point per tolerance; robust is exact at every tolerance, which only moves work between its stages)"
+set multiplot layout 1,2 title "CCD tolerance sweep 1e-8 ... 1e-1, all queries, one point per tolerance: errors against run time (robust is exact at every tolerance)"
 set logscale xy
 set grid
 set key top left
