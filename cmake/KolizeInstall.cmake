@@ -21,4 +21,5 @@ install(FILES
     "${CMAKE_CURRENT_BINARY_DIR}/kolizeConfig.cmake"
     "${CMAKE_CURRENT_BINARY_DIR}/kolizeConfigVersion.cmake"
     cmake/KolizeBullet.cmake
+    cmake/KolizeGmp.cmake
     DESTINATION ${KOLIZE_INSTALL_CMAKEDIR})

@@ -42,14 +42,6 @@ struct Options {
     std::string replay;
 };
 
-std::string joinedNames() {
-    std::string out;
-    for (const std::string& name : kolize::broadphaseNames()) {
-        out += (out.empty() ? "" : ", ") + name;
-    }
-    return out;
-}
-
 [[noreturn]] void fail(const std::string& message) {
     std::fprintf(stderr, "kolize-demo: %s (try --help)\n", message.c_str());
     std::exit(2);
@@ -69,7 +61,7 @@ Options parse(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
         if (flag == "--help" || flag == "-h") {
-            std::printf(kUsage, joinedNames().c_str());
+            std::printf(kUsage, kolize::broadphaseNameList().c_str());
             std::exit(0);
         }
         if (i + 1 >= argc) {
@@ -85,7 +77,7 @@ Options parse(int argc, char** argv) {
                 options.broadphases = {value};
             } else {
                 fail(std::string("unknown broadphase '") + value + "'; valid: all, " +
-                     joinedNames());
+                     kolize::broadphaseNameList());
             }
         } else if (flag == "--frames") {
             options.frames = positive(flag, value);

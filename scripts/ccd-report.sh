@@ -39,13 +39,13 @@ done
 gnuplot <<GNUPLOT
 set terminal pngcairo size 1200,500 noenhanced
 set output "$out/sweep.png"
-set multiplot layout 1,2 title "CCD tolerance sweep 1e-8 ... 1e-1 over all queries: error against run time (one point per tolerance; robust: larger tolerance = faster)"
+set multiplot layout 1,2 title "CCD tolerance sweep 1e-8 ... 1e-1, all queries, one point per tolerance: errors against run time (robust is exact at every tolerance)"
 set logscale xy
 set grid
 set key top left
 set xlabel "mean time per query (us)"
 set ylabel "false positives + 1"
-set title "False positives"
+set title "False positives (robust: always 0)"
 plot "$out/sweep-cubic.dat" using 1:(\$2+1) with linespoints title "cubic (thesis)", \
      "$out/sweep-robust.dat" using 1:(\$2+1) with linespoints title "robust"
 set ylabel "false negatives + 1"
@@ -91,7 +91,8 @@ GNUPLOT
 if [ -x "$build/demos/ccd/kolize-ccd-mesh-demo" ] || \
     nice -n 10 cmake --build "$build" -j1 --target kolize-ccd-mesh-demo 2>/dev/null; then
     for model in /usr/share/assimp/models/PLY/cube.ply \
-        /usr/share/assimp/models/STL/sphereWithHole.stl; do
+        /usr/share/assimp/models/STL/sphereWithHole.stl \
+        /usr/share/assimp/models/PLY/Wuson.ply; do
         [ -f "$model" ] && "$build/demos/ccd/kolize-ccd-mesh-demo" "$model"
     done | tee "$out/mesh.txt"
 fi

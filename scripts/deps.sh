@@ -2,7 +2,7 @@
 # Installs the Debian packages kolize needs, only those missing. Needs root (or sudo).
 set -euo pipefail
 packages=(cmake g++ make pkg-config libbullet-dev libeigen3-dev libassimp-dev assimp-testmodels
-          libbox2d-dev libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox)
+          libbox2d-dev libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox libgmp-dev)
 missing=()
 for package in "${packages[@]}"; do
     dpkg -s "$package" >/dev/null 2>&1 || missing+=("$package")

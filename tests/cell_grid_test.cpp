@@ -91,9 +91,9 @@ TEST(CellGrid, DenseScenesWithManyPairsPerCellMatchTheOracle) {
     UniformGrid<3, float> grid;
     SpatialTree<3, float> tree;
     SpatialHash<3, float> hash;
-    testkit::expectMeaningful(testkit::runCoreScenario<3, float>(grid, crowded), 5000);
-    testkit::expectMeaningful(testkit::runCoreScenario<3, float>(tree, crowded), 5000);
-    testkit::expectMeaningful(testkit::runCoreScenario<3, float>(hash, crowded), 5000);
+    testkit::expectMeaningful(testkit::runCoreScenario<3, float>(grid, crowded), 3000);
+    testkit::expectMeaningful(testkit::runCoreScenario<3, float>(tree, crowded), 3000);
+    testkit::expectMeaningful(testkit::runCoreScenario<3, float>(hash, crowded), 3000);
 }
 
 TEST(CellGrid, CellSizeIsReChosenWhenThePopulationDrifts) {

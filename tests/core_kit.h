@@ -315,6 +315,28 @@ CoreScenarioResult runCoreScenario(Core& core, const CoreScenario& scenario) {
         if (got != want || gotRay != wantRay) {
             return result;
         }
+        // Queries between frames must see moves made after the last pair search.
+        for (int m = 0; m < 5; ++m) {
+            const ObjectId id = liveIds[static_cast<std::size_t>(boxes.unit() * liveIds.size())];
+            box[id] = boxes.moved(box[id]);
+            core.update(id, box[id]);
+        }
+        gotRay.clear();
+        wantRay.clear();
+        core.queryRay(ray, [&](ObjectId id) {
+            if (rayHits(box[id], ray)) {
+                gotRay.insert(id);
+            }
+        });
+        for (ObjectId id : liveIds) {
+            if (rayHits(box[id], ray)) {
+                wantRay.insert(id);
+            }
+        }
+        EXPECT_EQ(gotRay, wantRay) << "ray query after moves, operation " << operation;
+        if (gotRay != wantRay) {
+            return result;
+        }
     }
     return result;
 }

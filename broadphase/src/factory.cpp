@@ -19,14 +19,6 @@ namespace {
 
 constexpr int kSap16MaxProxies = 32766;
 
-std::string nameList() {
-    std::string out;
-    for (const std::string& name : broadphaseNames()) {
-        out += (out.empty() ? "" : ", ") + name;
-    }
-    return out;
-}
-
 void requireCapacity(std::string_view name, int maxProxies, int limit) {
     if (maxProxies < 2 || maxProxies > limit) {
         throw std::invalid_argument("kolize: broadphase '" + std::string(name) +
@@ -42,6 +34,14 @@ const std::vector<std::string>& broadphaseNames() {
         "grid", "spatial-tree", "spatial-hash", "segment-trees", "range-tree", "brute-force",
         "dbvt", "sap",          "sap-noray",    "sap32",         "simple"};
     return names;
+}
+
+std::string broadphaseNameList() {
+    std::string out;
+    for (const std::string& name : broadphaseNames()) {
+        out += (out.empty() ? "" : ", ") + name;
+    }
+    return out;
 }
 
 bool isExactBroadphase(std::string_view name) {
@@ -95,7 +95,7 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
         return std::make_unique<btSimpleBroadphase>(settings.maxProxies, settings.pairCache);
     }
     throw std::invalid_argument("kolize: unknown broadphase '" + std::string(name) +
-                                "'; valid names: " + nameList());
+                                "'; valid names: " + broadphaseNameList());
 }
 
 }  // namespace kolize

@@ -1,4 +1,4 @@
-/// kolize-ccd-bench [DIR] [--csv FILE] [--sweep FILE] [--repeat N]
+/// kolize-ccd-bench [DIR] [--csv FILE] [--sweep FILE] [--repeat N] [--passes N]
 ///
 /// Runs every CCD method over a data set laid out as `<scene>/<vertex-face|edge-edge>/*.csv`
 /// (the Sample-Queries format, see assets/ccd-data/Sample-Queries/README.md) and compares
@@ -6,7 +6,9 @@
 /// positives, mean and median microseconds per query, overall and split into colliding
 /// and non-colliding queries. `--csv` writes one row per method, data set and kind (plus
 /// `all` rows per method and kind); `--sweep` runs every method at tolerances 1e-8 ... 1e-1
-/// and writes one row per method, tolerance and kind (error against run time).
+/// and writes one row per method, tolerance and kind (error against run time). A query's
+/// time is the median over `--passes` passes (default 3) of the mean of `--repeat`
+/// consecutive runs (default 3).
 #include "kolize/narrowphase/ccd_dataset.h"
 
 #include <algorithm>
@@ -18,6 +20,7 @@
 #include <functional>
 #include <iostream>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,14 +34,16 @@ struct Method {
     std::function<CcdResult(QueryKind, const LabeledQuery&)> run;
 };
 
-Method makeMethod(const std::string& name, double tolerance) {
+/// The method with its default settings, or with `tolerance` when given (a distance for
+/// `cubic`, the hand-off ratio of the floating-point stage for `robust`).
+Method makeMethod(const std::string& name, std::optional<double> tolerance = std::nullopt) {
     if (name == "cubic") {
         CubicSettings s;
-        s.tolerance = tolerance;
+        s.tolerance = tolerance.value_or(s.tolerance);
         return {name, [s](QueryKind k, const LabeledQuery& q) { return cubicQuery(k, q, s); }};
     }
     RobustSettings s;
-    s.tolerance = tolerance;
+    s.tolerance = tolerance.value_or(s.tolerance);
     return {name, [s](QueryKind k, const LabeledQuery& q) { return robustQuery(k, q, s); }};
 }
 
@@ -81,19 +86,28 @@ Stats summarize(const std::vector<Sample>& samples) {
     return s;
 }
 
-/// Runs each query `repeat` times and records the mean time of one run.
-std::vector<Sample> runSet(const Method& m, const QuerySet& set, int repeat) {
-    std::vector<Sample> out;
-    out.reserve(set.queries.size());
-    for (const LabeledQuery& q : set.queries) {
-        CcdResult r;
-        const auto t0 = std::chrono::steady_clock::now();
-        for (int i = 0; i < repeat; ++i) {
-            r = m.run(set.kind, q);
+/// Timing of one query: `passes` times, the mean of `repeat` consecutive runs; the query's
+/// time is the median over the passes. Passes go over the whole set in turn, so a burst of
+/// load on a shared machine (a preemption costs milliseconds, a query microseconds) spoils
+/// one pass of a few queries, not their reported time.
+std::vector<Sample> runSet(const Method& m, const QuerySet& set, int repeat, int passes) {
+    std::vector<std::vector<double>> times(set.queries.size());
+    std::vector<Sample> out(set.queries.size());
+    for (int pass = 0; pass < passes; ++pass) {
+        for (size_t q = 0; q < set.queries.size(); ++q) {
+            CcdResult r;
+            const auto t0 = std::chrono::steady_clock::now();
+            for (int i = 0; i < repeat; ++i) {
+                r = m.run(set.kind, set.queries[q]);
+            }
+            const auto t1 = std::chrono::steady_clock::now();
+            times[q].push_back(std::chrono::duration<double, std::micro>(t1 - t0).count() / repeat);
+            out[q] = {set.queries[q].collides, r.hit, 0.0};
         }
-        const auto t1 = std::chrono::steady_clock::now();
-        const double us = std::chrono::duration<double, std::micro>(t1 - t0).count() / repeat;
-        out.push_back({q.collides, r.hit, us});
+    }
+    for (size_t q = 0; q < out.size(); ++q) {
+        std::nth_element(times[q].begin(), times[q].begin() + passes / 2, times[q].end());
+        out[q].us = times[q][passes / 2];
     }
     return out;
 }
@@ -107,7 +121,8 @@ std::string defaultDir() {
 }
 
 int usage() {
-    std::cerr << "usage: kolize-ccd-bench [DIR] [--csv FILE] [--sweep FILE] [--repeat N]\n";
+    std::cerr << "usage: kolize-ccd-bench [DIR] [--csv FILE] [--sweep FILE] [--repeat N] "
+                 "[--passes N]\n";
     return 2;
 }
 
@@ -115,17 +130,20 @@ int usage() {
 
 int main(int argc, char** argv) {
     std::string dir, csv_path, sweep_path;
-    int repeat = 3;
+    int repeat = 3, passes = 3;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        if ((a == "--csv" || a == "--sweep" || a == "--repeat") && i + 1 < argc) {
+        if ((a == "--csv" || a == "--sweep" || a == "--repeat" || a == "--passes") &&
+            i + 1 < argc) {
             const std::string v = argv[++i];
             if (a == "--csv") {
                 csv_path = v;
             } else if (a == "--sweep") {
                 sweep_path = v;
-            } else {
+            } else if (a == "--repeat") {
                 repeat = std::max(1, std::atoi(v.c_str()));
+            } else {
+                passes = std::max(1, std::atoi(v.c_str()));
             }
         } else if (!a.empty() && a[0] != '-' && dir.empty()) {
             dir = a;
@@ -147,8 +165,10 @@ int main(int argc, char** argv) {
     for (const auto& s : sets) {
         total += s.queries.size();
     }
-    std::printf("data: %s (%zu queries in %zu sets), %d timed runs per query\n\n", dir.c_str(),
-                total, sets.size(), repeat);
+    std::printf(
+        "data: %s (%zu queries in %zu sets); a query's time: median over %d passes of the "
+        "mean of %d runs\n\n",
+        dir.c_str(), total, sets.size(), passes, repeat);
 
     std::ofstream csv;
     if (!csv_path.empty()) {
@@ -162,10 +182,10 @@ int main(int argc, char** argv) {
     std::printf(header, "method", "dataset", "kind", "N", "pos", "FN", "FP", "mean_us", "med_us",
                 "mean+", "med+", "mean-", "med-");
     for (const std::string name : {"cubic", "robust"}) {
-        const Method m = makeMethod(name, 1e-6);
+        const Method m = makeMethod(name);
         std::vector<Sample> per_kind[2];
         for (const QuerySet& set : sets) {
-            const auto samples = runSet(m, set, repeat);
+            const auto samples = runSet(m, set, repeat, passes);
             auto& acc = per_kind[set.kind == QueryKind::kEdgeEdge];
             acc.insert(acc.end(), samples.begin(), samples.end());
             const Stats s = summarize(samples);
@@ -198,7 +218,9 @@ int main(int argc, char** argv) {
     std::printf(
         "N: queries, pos: colliding queries (ground truth), FN/FP: false negatives/"
         "positives;\ntimes in microseconds per query: all, colliding (+), "
-        "non-colliding (-). Tolerance 1e-6.\n");
+        "non-colliding (-). Default settings:\ncubic tolerance %g (scene units), robust "
+        "tolerance %g (hand-off ratio; its answers are exact at any tolerance).\n",
+        CubicSettings{}.tolerance, RobustSettings{}.tolerance);
 
     if (!sweep_path.empty()) {
         std::ofstream sweep(sweep_path);
@@ -211,7 +233,7 @@ int main(int argc, char** argv) {
                 const Method m = makeMethod(name, tol);
                 std::vector<Sample> per_kind[3];
                 for (const QuerySet& set : sets) {
-                    const auto samples = runSet(m, set, repeat);
+                    const auto samples = runSet(m, set, repeat, passes);
                     auto& acc = per_kind[set.kind == QueryKind::kEdgeEdge];
                     acc.insert(acc.end(), samples.begin(), samples.end());
                     per_kind[2].insert(per_kind[2].end(), samples.begin(), samples.end());

@@ -3,12 +3,12 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
-#include <utility>
 #include <stdexcept>
 #include <unordered_set>
+#include <utility>
 
 namespace kolize::ccd {
 namespace {
@@ -29,22 +29,43 @@ struct Aabb {
     }
 };
 
-/// Box around a triangle's positions at t = 0 and t = 1; by convexity it contains the
-/// triangle at every t in [0, 1]. Comparisons on exact inputs: no rounding involved.
-Aabb sweptBox(const MovingMesh& m, const std::array<int, 3>& tri) {
-    Aabb box;
-    for (int v : tri) {
-        box.grow(m.start[v]);
-        box.grow(m.end[v]);
+/// What a mesh contributes to the primitive tests: each vertex used by a triangle, each
+/// edge once (shared edges are tested once), each triangle.
+struct Features {
+    std::vector<int> vertices;
+    std::vector<std::array<int, 2>> edges;  ///< smaller vertex index first
+};
+
+Features collectFeatures(const MovingMesh& m) {
+    Features f;
+    std::vector<char> used(m.start.size(), 0);
+    std::unordered_set<uint64_t> seen;
+    for (const auto& tri : m.triangles) {
+        for (int i = 0; i < 3; ++i) {
+            used[tri[i]] = 1;
+            const int lo = std::min(tri[i], tri[(i + 1) % 3]);
+            const int hi = std::max(tri[i], tri[(i + 1) % 3]);
+            if (lo != hi &&
+                seen.insert(static_cast<uint64_t>(lo) << 32 | static_cast<uint32_t>(hi)).second) {
+                f.edges.push_back({lo, hi});
+            }
+        }
     }
-    return box;
+    for (size_t v = 0; v < used.size(); ++v) {
+        if (used[v]) {
+            f.vertices.push_back(static_cast<int>(v));
+        }
+    }
+    return f;
 }
 
-/// Binary hierarchy over swept triangle boxes, built by median split on the longest axis.
-class SweptBvh {
+/// Binary hierarchy over boxes that change from one time slice to the next: the topology
+/// is built once (median split on the longest axis of the boxes over the whole step) and
+/// only the node boxes are recomputed per slice, bottom-up.
+class SliceBvh {
   public:
-    explicit SweptBvh(const std::vector<Aabb>& boxes) : boxes_(boxes) {
-        order_.resize(boxes.size());
+    explicit SliceBvh(const std::vector<Aabb>& whole_step) : leaf_boxes_(whole_step) {
+        order_.resize(whole_step.size());
         for (size_t i = 0; i < order_.size(); ++i) {
             order_[i] = static_cast<int>(i);
         }
@@ -54,28 +75,65 @@ class SweptBvh {
         }
     }
 
-    /// Calls visit(triangle) for every triangle whose swept box overlaps `query`.
-    template <class Visit>
-    void query(const Aabb& query, Visit visit) const {
-        if (nodes_.empty()) {
-            return;
-        }
-        std::vector<int> stack{0};
-        while (!stack.empty()) {
-            const Node& n = nodes_[stack.back()];
-            stack.pop_back();
-            if (!n.box.overlaps(query)) {
-                continue;
-            }
-            if (n.count > 0) {
-                for (size_t i = n.first; i < n.first + n.count; ++i) {
-                    if (boxes_[order_[i]].overlaps(query)) {
-                        visit(order_[i]);
-                    }
+    /// Leaf i's box for the current slice; call refit() after setting them all.
+    Aabb& leaf(size_t i) { return leaf_boxes_[i]; }
+
+    /// Recomputes the node boxes from the leaf boxes. Children are stored after their
+    /// parent, so one backward pass sees every child before its parent.
+    void refit() {
+        for (size_t n = nodes_.size(); n-- > 0;) {
+            Node& node = nodes_[n];
+            node.box = Aabb();
+            if (node.count > 0) {
+                for (size_t i = node.first; i < node.first + node.count; ++i) {
+                    node.box.grow(leaf_boxes_[order_[i]]);
                 }
             } else {
-                stack.push_back(n.left);
-                stack.push_back(n.left + 1);
+                node.box.grow(nodes_[node.left].box);
+                node.box.grow(nodes_[node.left + 1].box);
+            }
+        }
+    }
+
+    bool empty() const { return nodes_.empty(); }
+    const Aabb& bounds() const { return nodes_.front().box; }
+
+    /// Calls visit(i, j) for every leaf i of `a` and leaf j of `b` whose boxes overlap,
+    /// by descending both hierarchies together.
+    template <class Visit>
+    static void overlapping(const SliceBvh& a, const SliceBvh& b, Visit visit) {
+        if (a.empty() || b.empty()) {
+            return;
+        }
+        std::vector<std::pair<int, int>> stack{{0, 0}};
+        while (!stack.empty()) {
+            const auto [ia, ib] = stack.back();
+            stack.pop_back();
+            const Node& na = a.nodes_[ia];
+            const Node& nb = b.nodes_[ib];
+            if (!na.box.overlaps(nb.box)) {
+                continue;
+            }
+            if (na.count > 0 && nb.count > 0) {
+                for (size_t i = na.first; i < na.first + na.count; ++i) {
+                    const int leaf_a = a.order_[i];
+                    const Aabb& box_a = a.leaf_boxes_[leaf_a];
+                    if (!box_a.overlaps(nb.box)) {
+                        continue;
+                    }
+                    for (size_t j = nb.first; j < nb.first + nb.count; ++j) {
+                        const int leaf_b = b.order_[j];
+                        if (box_a.overlaps(b.leaf_boxes_[leaf_b])) {
+                            visit(leaf_a, leaf_b);
+                        }
+                    }
+                }
+            } else if (nb.count > 0 || (na.count == 0 && na.size >= nb.size)) {
+                stack.push_back({na.left, ib});  // descend the larger inner node
+                stack.push_back({na.left + 1, ib});
+            } else {
+                stack.push_back({ia, nb.left});
+                stack.push_back({ia, nb.left + 1});
             }
         }
     }
@@ -84,17 +142,16 @@ class SweptBvh {
     struct Node {
         Aabb box;
         int left = -1;  // children at left and left + 1 when count == 0
-        size_t first = 0, count = 0;
+        size_t first = 0, count = 0, size = 0;
     };
 
-    /// Fills node `slot` with the triangles order_[first, last); children of an inner
-    /// node are stored next to each other.
-    void build(int slot, size_t first, size_t last) {
+    void build(size_t slot, size_t first, size_t last) {
         Aabb box;
         for (size_t i = first; i < last; ++i) {
-            box.grow(boxes_[order_[i]]);
+            box.grow(leaf_boxes_[order_[i]]);
         }
         nodes_[slot].box = box;
+        nodes_[slot].size = last - first;
         if (last - first <= 4) {
             nodes_[slot].first = first;
             nodes_[slot].count = last - first;
@@ -105,8 +162,8 @@ class SweptBvh {
         const size_t mid = (first + last) / 2;
         std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + last,
                          [&](int x, int y) {
-                             return boxes_[x].lo[axis] + boxes_[x].hi[axis] <
-                                    boxes_[y].lo[axis] + boxes_[y].hi[axis];
+                             return leaf_boxes_[x].lo[axis] + leaf_boxes_[x].hi[axis] <
+                                    leaf_boxes_[y].lo[axis] + leaf_boxes_[y].hi[axis];
                          });
         const int left = static_cast<int>(nodes_.size());
         nodes_.emplace_back();
@@ -116,7 +173,7 @@ class SweptBvh {
         build(left + 1, mid, last);
     }
 
-    const std::vector<Aabb>& boxes_;
+    std::vector<Aabb> leaf_boxes_;
     std::vector<int> order_;
     std::vector<Node> nodes_;
 };
@@ -134,16 +191,6 @@ void validate(const MovingMesh& m) {
     }
 }
 
-/// Identifies one primitive test: (kind, feature of A, feature of B), each feature packed
-/// into 64 bits (a vertex or triangle index, or an edge's two vertex indices).
-using TestKey = std::pair<uint64_t, uint64_t>;
-
-struct TestKeyHash {
-    size_t operator()(const TestKey& k) const {
-        return std::hash<uint64_t>()(k.first * 0x9E3779B97F4A7C15ull ^ k.second);
-    }
-};
-
 /// The thesis's culling predicate: true when vertex v's motion relative to the triangle's
 /// centroid does not point against the triangle's normal at t = 0.
 bool facesAway(const MovingMesh& vm, int v, const MovingMesh& fm, const std::array<int, 3>& f) {
@@ -154,18 +201,129 @@ bool facesAway(const MovingMesh& vm, int v, const MovingMesh& fm, const std::arr
     return n.dot((vm.end[v] - vm.start[v]) - face_motion) >= 0.0;
 }
 
-uint64_t pack(uint64_t x, uint64_t y) {
-    return x << 32 | y;
-}
+/// One mesh's features with a hierarchy per kind, and their boxes for a time slice.
+class SlicedMesh {
+  public:
+    SlicedMesh(const MovingMesh& m, double margin)
+        : mesh_(m),
+          features_(collectFeatures(m)),
+          margin_(margin),
+          vertices_(wholeStepBoxes(features_.vertices.size(),
+                                   [&](size_t i, Aabb& b) { sweep(features_.vertices[i], b); })),
+          edges_(wholeStepBoxes(features_.edges.size(),
+                                [&](size_t i, Aabb& b) {
+                                    sweep(features_.edges[i][0], b);
+                                    sweep(features_.edges[i][1], b);
+                                })),
+          triangles_(wholeStepBoxes(m.triangles.size(), [&](size_t i, Aabb& b) {
+              for (int v : m.triangles[i]) {
+                  sweep(v, b);
+              }
+          })) {
+        at0_.resize(m.start.size());
+        at1_.resize(m.start.size());
+    }
 
-TestKey vertexFaceKey(int kind, int vertex, int triangle) {
-    return {pack(kind, static_cast<uint32_t>(vertex)), static_cast<uint32_t>(triangle)};
-}
+    /// Vertex positions at t0 and t1, and the box around them all (inflated).
+    Aabb positions(double t0, double t1) {
+        Aabb all;
+        for (int v : features_.vertices) {
+            at0_[v] = mesh_.start[v] + t0 * (mesh_.end[v] - mesh_.start[v]);
+            at1_[v] = mesh_.start[v] + t1 * (mesh_.end[v] - mesh_.start[v]);
+            all.grow(at0_[v]);
+            all.grow(at1_[v]);
+        }
+        inflate(all);
+        return all;
+    }
 
-TestKey edgeEdgeKey(int a0, int a1, int b0, int b1) {
-    return {pack(2ull << 30 | static_cast<uint32_t>(std::min(a0, a1)),
-                 static_cast<uint32_t>(std::max(a0, a1))),
-            pack(static_cast<uint32_t>(std::min(b0, b1)), static_cast<uint32_t>(std::max(b0, b1)))};
+    /// Leaf boxes of every hierarchy for the slice whose positions() were computed last.
+    void refit() {
+        for (size_t i = 0; i < features_.vertices.size(); ++i) {
+            Aabb& b = vertices_.leaf(i) = Aabb();
+            slice(features_.vertices[i], b);
+            inflate(b);
+        }
+        vertices_.refit();
+        for (size_t i = 0; i < features_.edges.size(); ++i) {
+            Aabb& b = edges_.leaf(i) = Aabb();
+            slice(features_.edges[i][0], b);
+            slice(features_.edges[i][1], b);
+            inflate(b);
+        }
+        edges_.refit();
+        for (size_t i = 0; i < mesh_.triangles.size(); ++i) {
+            Aabb& b = triangles_.leaf(i) = Aabb();
+            for (int v : mesh_.triangles[i]) {
+                slice(v, b);
+            }
+            inflate(b);
+        }
+        triangles_.refit();
+    }
+
+    const MovingMesh& mesh() const { return mesh_; }
+    const Features& features() const { return features_; }
+    const SliceBvh& vertices() const { return vertices_; }
+    const SliceBvh& edges() const { return edges_; }
+    const SliceBvh& triangles() const { return triangles_; }
+
+  private:
+    template <class Fill>
+    static std::vector<Aabb> wholeStepBoxes(size_t count, Fill fill) {
+        std::vector<Aabb> boxes(count);
+        for (size_t i = 0; i < count; ++i) {
+            fill(i, boxes[i]);
+        }
+        return boxes;
+    }
+    void sweep(int v, Aabb& b) const {
+        b.grow(mesh_.start[v]);
+        b.grow(mesh_.end[v]);
+    }
+    void slice(int v, Aabb& b) const {
+        b.grow(at0_[v]);
+        b.grow(at1_[v]);
+    }
+    void inflate(Aabb& b) const {
+        b.lo.array() -= margin_;
+        b.hi.array() += margin_;
+    }
+
+    const MovingMesh& mesh_;
+    Features features_;
+    double margin_;
+    SliceBvh vertices_, edges_, triangles_;
+    std::vector<Vec3> at0_, at1_;
+};
+
+/// Time slices: enough that a slice moves the fastest vertex pair by about one mean edge
+/// length (a power of two, so slice ends are exact doubles), at most `limit`.
+int sliceCount(const MovingMesh& a, const MovingMesh& b, int limit) {
+    auto largestMotion = [](const MovingMesh& m) {
+        double d = 0.0;
+        for (size_t v = 0; v < m.start.size(); ++v) {
+            d = std::max(d, (m.end[v] - m.start[v]).norm());
+        }
+        return d;
+    };
+    double edge_sum = 0.0;
+    size_t edge_count = 0;
+    for (const MovingMesh* m : {&a, &b}) {
+        for (const auto& tri : m->triangles) {
+            for (int i = 0; i < 3; ++i) {
+                edge_sum += (m->start[tri[i]] - m->start[tri[(i + 1) % 3]]).norm();
+                ++edge_count;
+            }
+        }
+    }
+    const double edge = edge_count ? edge_sum / edge_count : 0.0;
+    const double motion = largestMotion(a) + largestMotion(b);
+    int slices = 1;
+    while (2 * slices <= limit && motion > slices * edge) {
+        slices *= 2;
+    }
+    return slices;
 }
 
 }  // namespace
@@ -173,20 +331,22 @@ TestKey edgeEdgeKey(int a0, int a1, int b0, int b1) {
 MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSettings& settings) {
     validate(a);
     validate(b);
-    std::vector<Aabb> boxes_b;
-    boxes_b.reserve(b.triangles.size());
-    for (const auto& tri : b.triangles) {
-        boxes_b.push_back(sweptBox(b, tri));
+    // Slice boxes come from positions x0 + t (x1 - x0) rounded to doubles: inflating every
+    // box by a few units in the last place of the largest coordinate keeps it around the
+    // exact positions, so the culling never drops a pair that touches.
+    double largest = 0.0;
+    for (const MovingMesh* m : {&a, &b}) {
+        for (size_t v = 0; v < m->start.size(); ++v) {
+            largest = std::max(
+                {largest, m->start[v].cwiseAbs().maxCoeff(), m->end[v].cwiseAbs().maxCoeff()});
+        }
     }
-    const SweptBvh bvh(boxes_b);
+    const double margin = 8.0 * 0x1p-53 * largest + std::numeric_limits<double>::min();
+    SlicedMesh sa(a, margin), sb(b, margin);
+    const int slices = sliceCount(a, b, settings.max_time_slices);
 
     MeshContact best;
-    // Once a contact is known, only earlier ones matter: the primitive tests search
-    // [0, best.toi] (the earliest true contact is either found there or is later than a
-    // reported toi, so the minimum stays no later than the truth).
     RobustSettings primitive = settings.primitive;
-    // Vertices and edges are shared between triangles: test each primitive pair once.
-    std::unordered_set<TestKey, TestKeyHash> tested;
     auto consider = [&](const CcdResult& r, ContactFeatures f, std::array<int, 2> fa,
                         std::array<int, 2> fb) {
         if (r.hit && (!best.hit || r.toi < best.toi)) {
@@ -198,54 +358,61 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
             best.b = fb;
         }
     };
-    for (size_t ta = 0; ta < a.triangles.size(); ++ta) {
-        const auto& tri_a = a.triangles[ta];
-        bvh.query(sweptBox(a, tri_a), [&](int tb) {
-            ++best.triangle_pairs;
-            const auto& tri_b = b.triangles[tb];
-            for (int i = 0; i < 3; ++i) {
-                // Vertex of A against triangle of B, and vertex of B against triangle of A.
-                if (tested.insert(vertexFaceKey(0, tri_a[i], tb)).second) {
-                    const int v = tri_a[i];
-                    if (settings.cull_back_facing && facesAway(a, v, b, tri_b)) {
-                        ++best.culled;
-                    } else {
-                        ++best.primitive_queries;
-                        VertexFaceQuery q{
-                            {a.start[v], b.start[tri_b[0]], b.start[tri_b[1]], b.start[tri_b[2]]},
-                            {a.end[v], b.end[tri_b[0]], b.end[tri_b[1]], b.end[tri_b[2]]}};
-                        consider(vertexFaceRobust(q, primitive), ContactFeatures::kVertexAFaceB,
-                                 {v, -1}, {tb, -1});
-                    }
-                }
-                if (tested.insert(vertexFaceKey(1, tri_b[i], static_cast<int>(ta))).second) {
-                    const int v = tri_b[i];
-                    if (settings.cull_back_facing && facesAway(b, v, a, tri_a)) {
-                        ++best.culled;
-                    } else {
-                        ++best.primitive_queries;
-                        VertexFaceQuery q{
-                            {b.start[v], a.start[tri_a[0]], a.start[tri_a[1]], a.start[tri_a[2]]},
-                            {b.end[v], a.end[tri_a[0]], a.end[tri_a[1]], a.end[tri_a[2]]}};
-                        consider(vertexFaceRobust(q, primitive), ContactFeatures::kFaceAVertexB,
-                                 {static_cast<int>(ta), -1}, {v, -1});
-                    }
-                }
+    // Slices in time order: the first slice with a contact holds the earliest one, and
+    // every test is limited to its slice, where its features' boxes overlap.
+    const double t_begin = std::clamp(settings.primitive.min_time, 0.0, 1.0);
+    const double t_end = std::clamp(settings.primitive.max_time, t_begin, 1.0);
+    for (int s = 0; s < slices && !best.hit; ++s) {
+        const double t0 = std::max(t_begin, double(s) / slices);
+        const double t1 = std::min(t_end, double(s + 1) / slices);
+        if (t1 < t0 || (t1 == t0 && best.time_slices > 0)) {
+            continue;  // outside [t_begin, t_end], or its end instant, already covered
+        }
+        ++best.time_slices;
+        if (!sa.positions(t0, t1).overlaps(sb.positions(t0, t1))) {
+            continue;
+        }
+        sa.refit();
+        sb.refit();
+        primitive.min_time = t0;
+        primitive.max_time = t1;
+        // Vertex of A against triangle of B, and triangle of A against vertex of B.
+        SliceBvh::overlapping(sa.vertices(), sb.triangles(), [&](int i, int tb) {
+            ++best.candidate_pairs;
+            const int v = sa.features().vertices[i];
+            const auto& tri = b.triangles[tb];
+            if (settings.cull_back_facing && facesAway(a, v, b, tri)) {
+                ++best.culled;
+                return;
             }
-            for (int i = 0; i < 3; ++i) {
-                const int a0 = tri_a[i], a1 = tri_a[(i + 1) % 3];
-                for (int j = 0; j < 3; ++j) {
-                    const int b0 = tri_b[j], b1 = tri_b[(j + 1) % 3];
-                    if (!tested.insert(edgeEdgeKey(a0, a1, b0, b1)).second) {
-                        continue;
-                    }
-                    ++best.primitive_queries;
-                    EdgeEdgeQuery q{{a.start[a0], a.start[a1], b.start[b0], b.start[b1]},
-                                    {a.end[a0], a.end[a1], b.end[b0], b.end[b1]}};
-                    consider(edgeEdgeRobust(q, primitive), ContactFeatures::kEdgeEdge, {a0, a1},
-                             {b0, b1});
-                }
+            ++best.primitive_queries;
+            const VertexFaceQuery q{{a.start[v], b.start[tri[0]], b.start[tri[1]], b.start[tri[2]]},
+                                    {a.end[v], b.end[tri[0]], b.end[tri[1]], b.end[tri[2]]}};
+            consider(vertexFaceRobust(q, primitive), ContactFeatures::kVertexAFaceB, {v, -1},
+                     {tb, -1});
+        });
+        SliceBvh::overlapping(sa.triangles(), sb.vertices(), [&](int ta, int j) {
+            ++best.candidate_pairs;
+            const int v = sb.features().vertices[j];
+            const auto& tri = a.triangles[ta];
+            if (settings.cull_back_facing && facesAway(b, v, a, tri)) {
+                ++best.culled;
+                return;
             }
+            ++best.primitive_queries;
+            const VertexFaceQuery q{{b.start[v], a.start[tri[0]], a.start[tri[1]], a.start[tri[2]]},
+                                    {b.end[v], a.end[tri[0]], a.end[tri[1]], a.end[tri[2]]}};
+            consider(vertexFaceRobust(q, primitive), ContactFeatures::kFaceAVertexB, {ta, -1},
+                     {v, -1});
+        });
+        SliceBvh::overlapping(sa.edges(), sb.edges(), [&](int i, int j) {
+            ++best.candidate_pairs;
+            ++best.primitive_queries;
+            const auto& ea = sa.features().edges[i];
+            const auto& eb = sb.features().edges[j];
+            const EdgeEdgeQuery q{{a.start[ea[0]], a.start[ea[1]], b.start[eb[0]], b.start[eb[1]]},
+                                  {a.end[ea[0]], a.end[ea[1]], b.end[eb[0]], b.end[eb[1]]}};
+            consider(edgeEdgeRobust(q, primitive), ContactFeatures::kEdgeEdge, ea, eb);
         });
     }
     return best;

@@ -1,13 +1,17 @@
 // The robust CCD method over the whole Sample-Queries copy: zero false negatives is a hard
-// requirement; the false-positive bound is a regression guard at the measured level.
+// requirement, at most 1% false positives the issue's target (the method is exact: 0).
 #include "kolize/narrowphase/ccd_dataset.h"
+
+#include "ccd_exact.h"  // narrowphase/src: the exact decision on its own
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <stdexcept>
+#include <string>
 
 namespace {
 
@@ -40,7 +44,7 @@ TEST(CcdDataset, ReaderRefusesInexactCoordinates) {
     std::filesystem::remove(path);
 }
 
-TEST(CcdDataset, RobustHasNoFalseNegativesAndFewFalsePositives) {
+TEST(CcdDataset, RobustHasNoFalseNegativesAndAtMostOnePercentFalsePositives) {
     const auto sets = readQueryFolder(KOLIZE_CCD_DATA_DIR);
     const RobustSettings settings;
     size_t negatives = 0, false_positives = 0;
@@ -54,13 +58,105 @@ TEST(CcdDataset, RobustHasNoFalseNegativesAndFewFalsePositives) {
                 EXPECT_GE(r.toi, 0.0);
                 EXPECT_LE(r.toi, 1.0);
             }
+            if (r.hit && !q.collides) {
+                ++false_positives;
+                ADD_FAILURE() << "false positive (the decision is meant to be exact): " << set.scene
+                              << " " << kindName(set.kind) << " #" << i;
+            }
             negatives += !q.collides;
-            false_positives += r.hit && !q.collides;
         }
     }
-    // Measured: 210 of 3899 (5.4%), nearly all near-contacts closer than 1e-12, i.e.
-    // below what a double-precision evaluation can separate. Guard against regressions.
-    EXPECT_LE(false_positives, negatives * 6 / 100);
+    // The issue's target. The method is exact, so the measured count is 0 (it was 210 of
+    // 3899, 5.4%, when near-contacts ~1e-17 apart were accepted within a 1e-6 tolerance).
+    EXPECT_LE(false_positives * 100, negatives) << false_positives << " of " << negatives;
+}
+
+// The interval filter must never change an answer: the exact-only arithmetic agrees on
+// every query, and the two-stage robust method (floating-point search, then the exact
+// decision from the search's first unexcluded time) finds the same earliest contact as the
+// exact decision over the whole step. A search that excluded a box holding the first
+// contact would show up here as a later toi.
+TEST(CcdDataset, FilteredExactOnlyAndTwoStageDecisionsAgree) {
+    const auto sets = readQueryFolder(KOLIZE_CCD_DATA_DIR);
+    const RobustSettings settings;
+    const double slack = settings.toi_tolerance + 1e-15;
+    for (const auto& set : sets) {
+        const bool vf = set.kind == QueryKind::kVertexFace;
+        for (size_t i = 0; i < set.queries.size(); ++i) {
+            SCOPED_TRACE(set.scene + " " + kindName(set.kind) + " #" + std::to_string(i));
+            const LabeledQuery& q = set.queries[i];
+            auto exact = [&](detail::Arithmetic arithmetic) {
+                return vf ? detail::vertexFaceExact(q.start, q.end, 0.0, 1.0,
+                                                    settings.toi_tolerance, arithmetic)
+                          : detail::edgeEdgeExact(q.start, q.end, 0.0, 1.0, settings.toi_tolerance,
+                                                  arithmetic);
+            };
+            const detail::ExactContact filtered = exact(detail::Arithmetic::kFiltered);
+            const detail::ExactContact exact_only = exact(detail::Arithmetic::kExactOnly);
+            const CcdResult two_stage = robustQuery(set.kind, q, settings);
+            EXPECT_EQ(filtered.hit, q.collides);
+            ASSERT_EQ(exact_only.hit, filtered.hit);
+            ASSERT_EQ(two_stage.hit, filtered.hit);
+            if (filtered.hit) {
+                EXPECT_NEAR(exact_only.toi, filtered.toi, slack);
+                EXPECT_NEAR(two_stage.toi, filtered.toi, slack);
+            }
+        }
+    }
+}
+
+// The same agreement on random queries built to be degenerate: coordinates on a coarse
+// grid of halves (so coplanar motion, parallel edges, shared points and exact touches are
+// common and the filter often meets exact zeros), some nudged by a few units in the last
+// place (near-misses the filter cannot resolve).
+TEST(CcdRandomDegenerate, FilteredExactOnlyAndTwoStageDecisionsAgree) {
+    const unsigned seed = 5;
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> grid(-4, 4), nudge(-3, 3), coin(0, 3);
+    auto coordinate = [&] {
+        double x = 0.5 * grid(rng);
+        if (coin(rng) == 0) {
+            x += nudge(rng) * 0x1p-52;
+        }
+        return x;
+    };
+    auto point = [&] { return Vec3(coordinate(), coordinate(), coordinate()); };
+    const RobustSettings settings;
+    const double slack = settings.toi_tolerance + 1e-15;
+    int hits = 0;
+    const int trials = 3000;
+    for (int trial = 0; trial < trials; ++trial) {
+        SCOPED_TRACE("seed " + std::to_string(seed) + ", trial " + std::to_string(trial));
+        LabeledQuery q;
+        for (int i = 0; i < 4; ++i) {
+            q.start[i] = point();
+            // Often a vertex keeps still or shares its motion with the previous one.
+            const int motion = coin(rng);
+            q.end[i] = motion == 0            ? q.start[i]
+                       : motion == 1 && i > 0 ? q.start[i] + (q.end[i - 1] - q.start[i - 1])
+                                              : point();
+        }
+        const QueryKind kind = trial % 2 ? QueryKind::kEdgeEdge : QueryKind::kVertexFace;
+        auto exact = [&](detail::Arithmetic arithmetic) {
+            return kind == QueryKind::kVertexFace
+                       ? detail::vertexFaceExact(q.start, q.end, 0.0, 1.0, settings.toi_tolerance,
+                                                 arithmetic)
+                       : detail::edgeEdgeExact(q.start, q.end, 0.0, 1.0, settings.toi_tolerance,
+                                               arithmetic);
+        };
+        const detail::ExactContact filtered = exact(detail::Arithmetic::kFiltered);
+        const detail::ExactContact exact_only = exact(detail::Arithmetic::kExactOnly);
+        const CcdResult two_stage = robustQuery(kind, q, settings);
+        ASSERT_EQ(exact_only.hit, filtered.hit);
+        ASSERT_EQ(two_stage.hit, filtered.hit);
+        if (filtered.hit) {
+            EXPECT_NEAR(exact_only.toi, filtered.toi, slack);
+            EXPECT_NEAR(two_stage.toi, filtered.toi, slack);
+        }
+        hits += filtered.hit;
+    }
+    EXPECT_GT(hits, trials / 10) << "seed " << seed;
+    EXPECT_LT(hits, trials * 9 / 10) << "seed " << seed;
 }
 
 }  // namespace

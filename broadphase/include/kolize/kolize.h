@@ -45,6 +45,9 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
 /// All names makeBroadphase accepts, kolize's first.
 const std::vector<std::string>& broadphaseNames();
 
+/// The names, comma separated, for messages and help texts.
+std::string broadphaseNameList();
+
 /// True for the names whose pair output is exact (kolize's own broadphases).
 bool isExactBroadphase(std::string_view name);
 

@@ -100,6 +100,7 @@ class CellGrid {
         const Range range = rangeOf(box);
         // Same cells: nothing to do (unless a clamped box has left the dense region).
         if (object.state == State::InCells && range == object.range && !isOutside(box)) {
+            growContent(box);  // rays are clipped to the binned boxes' bounds
             return;
         }
         if (object.state == State::InCells && !belongsInOverflow(box, range)) {

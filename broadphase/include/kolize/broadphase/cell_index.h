@@ -220,6 +220,12 @@ inline bool keyLess(const CellKey<D>& a, const CellKey<D>& b) {
 template <int D, class Node>
 class SparsePool {
   public:
+    /// Sparse cells cover all of space: 64-bit coordinates, no region.
+    static constexpr bool kBounded = false;
+    using Coord = std::int64_t;
+    using Key = CellKey<D>;
+    using Range = CellRange<D>;
+
     CellRecord& record(std::uint32_t handle) { return nodes_[handle].record; }
     const CellRecord& record(std::uint32_t handle) const { return nodes_[handle].record; }
     CellKey<D> key(std::uint32_t handle) const { return nodes_[handle].key; }
@@ -304,11 +310,7 @@ class AvlIndex : public SparsePool<D, detail::AvlNode<D>> {
     using Base::nodes_;
 
   public:
-    static constexpr bool kBounded = false;
     static constexpr const char* kName = "AVL tree";
-    using Coord = std::int64_t;
-    using Key = CellKey<D>;
-    using Range = CellRange<D>;
 
     void clear() { *this = AvlIndex{}; }
     std::uint32_t find(const CellKey<D>& key) const {
@@ -507,11 +509,7 @@ class HashIndex : public SparsePool<D, detail::HashNode<D>> {
     using Base::nodes_;
 
   public:
-    static constexpr bool kBounded = false;
     static constexpr const char* kName = "hash table";
-    using Coord = std::int64_t;
-    using Key = CellKey<D>;
-    using Range = CellRange<D>;
 
     void clear() { *this = HashIndex{}; }
     std::uint32_t find(const CellKey<D>& key) const {

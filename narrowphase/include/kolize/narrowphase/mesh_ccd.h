@@ -1,11 +1,17 @@
 #pragma once
 /// Continuous collision detection between two triangle meshes over one step.
 ///
-/// Each mesh's vertices move linearly from `start` to `end` over t in [0, 1]. Candidate
-/// triangle pairs come from a bounding volume hierarchy of swept boxes (the box around a
-/// triangle's six positions contains it at every t in [0, 1]); every vertex-face and
-/// edge-edge pair of a candidate is tested with the robust primitive, so the result
-/// inherits its guarantee: no missed contact, and `toi` never later than the true one.
+/// Each mesh's vertices move linearly from `start` to `end` over t in [0, 1]. The step is
+/// cut into time slices (a power of two, at most `max_time_slices`, so that a slice moves
+/// the fastest vertices about one mean edge length), processed in time order. In a slice, every
+/// feature (vertex, edge, triangle) has a box around its positions at the slice's two ends,
+/// which contains it throughout the slice by convexity (inflated to cover rounding); a
+/// hierarchy per feature kind, built once and refitted per slice, is descended together
+/// with the other mesh's to find the vertex-triangle and edge-edge pairs whose boxes
+/// overlap, and each is tested with the robust primitive over the slice only. The first
+/// slice with a contact holds the earliest one. Every vertex and edge is tested once per
+/// slice. The result inherits the primitive's guarantee: a contact is reported if and only
+/// if the meshes touch, and `toi` is never later than the first contact.
 /// The thesis's "normal facing the motion" culling is available but off by default: it is
 /// unsafe (see MeshCcdSettings::cull_back_facing) and voids the guarantee.
 #include "kolize/narrowphase/ccd.h"
@@ -35,17 +41,20 @@ struct MeshContact {
     bool hit = false;
     double toi = 1.0;  ///< no later than the true earliest contact when `hit`
     ContactFeatures features = ContactFeatures::kVertexAFaceB;
-    std::array<int, 2> a{-1, -1};       ///< vertex, triangle or edge of mesh A (see features)
-    std::array<int, 2> b{-1, -1};       ///< vertex, triangle or edge of mesh B (see features)
-    std::size_t triangle_pairs = 0;     ///< candidate pairs whose swept boxes overlap
-    std::size_t primitive_queries = 0;  ///< distinct vertex-face and edge-edge tests run
+    std::array<int, 2> a{-1, -1};  ///< vertex, triangle or edge of mesh A (see features)
+    std::array<int, 2> b{-1, -1};  ///< vertex, triangle or edge of mesh B (see features)
+    /// Vertex-triangle and edge-edge pairs whose slice boxes overlap, summed over slices.
+    std::size_t candidate_pairs = 0;
+    std::size_t primitive_queries = 0;  ///< vertex-face and edge-edge tests run
     std::size_t culled = 0;             ///< vertex-face tests skipped by `cull_back_facing`
+    std::size_t time_slices = 0;        ///< slices examined (the step's, up to the contact)
 };
 
 /// Settings of the mesh-mesh test.
 struct MeshCcdSettings {
-    /// Settings of every vertex-face and edge-edge test (see RobustSettings). Meshes must
-    /// have fewer than 2^30 vertices (test bookkeeping packs indices into 32 bits).
+    /// Settings of every vertex-face and edge-edge test (see RobustSettings); its
+    /// [min_time, max_time] limits the mesh test too. Meshes must have fewer than 2^31
+    /// vertices.
     RobustSettings primitive;
     /// The thesis's culling: skip a vertex-face test when the vertex's motion relative to
     /// the face's centroid does not point against the face normal at t = 0 (normal from
@@ -53,6 +62,9 @@ struct MeshCcdSettings {
     /// within the step, and the test is skipped for a vertex already behind the face.
     /// kolize-ccd-mesh-demo measures what it saves and what it loses. Default off.
     bool cull_back_facing = false;
+    /// Upper bound on the number of time slices (rounded down to a power of two); 1 tests
+    /// every pair whose boxes over the whole step overlap (the slicing's reference).
+    int max_time_slices = 256;
 };
 
 /// Earliest time of impact between meshes `a` and `b` over the step, and the features
