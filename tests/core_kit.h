@@ -316,7 +316,7 @@ CoreScenarioResult runCoreScenario(Core& core, const CoreScenario& scenario) {
             return result;
         }
         // Queries between frames must see moves made after the last pair search.
-        for (int m = 0; m < 5; ++m) {
+        for (int m = 0; m < 5 && !liveIds.empty(); ++m) {
             const ObjectId id = liveIds[static_cast<std::size_t>(boxes.unit() * liveIds.size())];
             box[id] = boxes.moved(box[id]);
             core.update(id, box[id]);
