@@ -358,6 +358,50 @@ TEST(TreeCores, TouchingBoxesAndPointsAreCandidates) {
     }
 }
 
+// A ray across the whole scene is queried piece by piece: it reports the objects near it,
+// each once, not every object in its bounding box (which is the whole scene).
+template <class Core>
+void longRayVisitsObjectsNearIt() {
+    ThesisSceneSettings sceneSettings;
+    sceneSettings.objects = 3000;
+    ThesisScene<3> scene(sceneSettings);
+    Core core;
+    for (int i = 0; i < sceneSettings.objects; ++i) {
+        core.insert(ObjectId(i), scene.boxes()[i]);
+    }
+    Ray<3, double> ray;
+    const double length = 1000 * std::sqrt(3.0);
+    for (int axis = 0; axis < 3; ++axis) {
+        ray.origin[axis] = -500;
+        ray.inverseDirection[axis] = std::sqrt(3.0);
+        ray.sign[axis] = 0;
+        ray.expandLo[axis] = -3;  // a swept box, so that some cubes are hit
+        ray.expandHi[axis] = 3;
+    }
+    ray.lambdaMax = length;
+    std::set<ObjectId> visited;
+    std::size_t visits = 0;
+    core.queryRay(ray, [&](ObjectId id) {
+        ++visits;
+        visited.insert(id);
+    });
+    EXPECT_EQ(visits, visited.size()) << "an object was visited twice";
+    std::size_t hits = 0;
+    for (int i = 0; i < sceneSettings.objects; ++i) {
+        if (rayHits(scene.boxes()[i], ray)) {
+            ++hits;
+            EXPECT_EQ(visited.count(ObjectId(i)), 1u) << "missed object " << i;
+        }
+    }
+    EXPECT_GT(hits, 0u) << "the ray should hit something";
+    EXPECT_LT(visits, std::size_t(sceneSettings.objects / 20));
+}
+
+TEST(TreeCores, LongRaysVisitTheObjectsNearThemOnce) {
+    longRayVisitsObjectsNearIt<SegmentTreeSet<3, double>>();
+    longRayVisitsObjectsNearIt<RangeTree<3, double>>();
+}
+
 /// Replays `stream` into the tree broadphases; no false negative, no false positive.
 void expectExactReplay(const PairStream& stream, std::size_t minPairs) {
     for (const char* name : {"segment-trees", "range-tree"}) {

@@ -224,24 +224,57 @@ class CellCore {
     /// The cell box of live object `id`.
     const CellBox<D>& cellsOf(ObjectId id) const { return cells_[id]; }
 
-    /// Calls `visit(id)` once for every live object whose cells meet the ray's bounds
-    /// (rayBounds), through the derived core's queryBox; the adapter's exact test does the
-    /// rest.
+    /// Calls `visit(id)` once for every live object whose cells meet the ray's bounds; the
+    /// adapter's exact test does the rest. A ray longer than 16 cells is cut into pieces of
+    /// about 16 cells (at most 1024), each queried through its own bounds, so that a long
+    /// diagonal ray reports the objects near it rather than every object in its bounding
+    /// box. An object is reported from the first piece it meets: the pieces' cell boxes
+    /// advance monotonically on every axis, so the pieces an object meets are consecutive,
+    /// and the first is the one whose predecessor it does not meet.
     template <class Visit>
     void queryRay(const Ray<D, Scalar>& ray, Visit&& visit) const {
-        derived().queryBox(rayBounds(ray), visit);
+        if (live_.empty()) {
+            return;
+        }
+        const CellBox<D> whole = cellsForQuery(rayBounds(ray, 0, 1));
+        std::int64_t longest = 0;
+        bool finite = true;
+        for (int axis = 0; axis < D; ++axis) {
+            longest = std::max(longest, std::int64_t(whole.hi[axis]) - whole.lo[axis]);
+            finite =
+                finite && std::isfinite(double(ray.lambdaMax) / double(ray.inverseDirection[axis]));
+        }
+        const int pieces =
+            finite ? static_cast<int>(std::min<std::int64_t>(longest / 16 + 1, 1024)) : 1;
+        if (pieces == 1) {
+            derived().visitCells(whole, visit);
+            return;
+        }
+        CellBox<D> previous;
+        for (int piece = 0; piece < pieces; ++piece) {
+            const CellBox<D> cells =
+                cellsForQuery(rayBounds(ray, double(piece) / pieces, double(piece + 1) / pieces));
+            derived().visitCells(cells, [&](ObjectId id) {
+                if (piece == 0 || !cellsOverlap(cells_[id], previous)) {
+                    visit(id);
+                }
+            });
+            previous = cells;
+        }
     }
 
-    /// The box a ray query must cover: the segment's bounds (with a relative margin for the
-    /// rounding in Bullet's slab test), grown by the swept box as expandedForRay does.
-    static Box rayBounds(const Ray<D, Scalar>& ray) {
+    /// The box a ray query must cover between fractions `from` and `to` of the segment: the
+    /// piece's bounds, with a margin for the rounding in Bullet's slab test (relative to the
+    /// whole segment), grown by the swept box as expandedForRay does.
+    static Box rayBounds(const Ray<D, Scalar>& ray, double from = 0, double to = 1) {
         Box out;
         for (int axis = 0; axis < D; ++axis) {
             const double origin = double(ray.origin[axis]);
-            const double end = origin + double(ray.lambdaMax) / double(ray.inverseDirection[axis]);
-            const double margin = 1e-5 * (std::fabs(origin) + std::fabs(end - origin) + 1);
-            const double lo = std::min(origin, end) - margin + double(ray.expandLo[axis]);
-            const double hi = std::max(origin, end) + margin + double(ray.expandHi[axis]);
+            const double span = double(ray.lambdaMax) / double(ray.inverseDirection[axis]);
+            const double margin = 1e-5 * (std::fabs(origin) + std::fabs(span) + 1);
+            const double start = origin + span * from, end = origin + span * to;
+            const double lo = std::min(start, end) - margin + double(ray.expandLo[axis]);
+            const double hi = std::max(start, end) + margin + double(ray.expandHi[axis]);
             out.lo[axis] = static_cast<Scalar>(std::isnan(lo) ? -HUGE_VAL : lo);
             out.hi[axis] = static_cast<Scalar>(std::isnan(hi) ? HUGE_VAL : hi);
         }
