@@ -13,9 +13,11 @@
 ///
 /// Tuning: the first insert, every insert that doubles the live count since the last
 /// tuning, the first findCandidates, and any later one after the count grew by a quarter
-/// recompute U
-/// (tuneScene); when it changed, the trees are rebuilt. That is amortised O(log N) per
-/// insert and keeps U fitted to a scene that is built up over time.
+/// recompute U (tuneScene); when it changed, the trees are rebuilt. That is amortised
+/// O(log N) per insert and keeps U fitted to a scene that is built up over time.
+///
+/// Updates: an object whose box stays inside the coordinates that map to its cells (kept
+/// per object) costs a few comparisons; only a changed cell box reaches the derived core.
 
 #include <kolize/broadphase/aabb.h>
 #include <kolize/broadphase/segment_tree.h>

@@ -11,9 +11,10 @@ struct CellTuning {
     /// 3.3, 1.5 x the distance of the farthest object from the origin, except that kolize
     /// ignores box centres more than twice as far as the 99th percentile of the distances,
     /// so that a few far objects do not coarsen everyone's cells. More cells: fewer false
-    /// candidates, deeper trees. The
-    /// thesis chose 1000 (its table 2.1: 2000 marginally faster, 1000 less memory).
-    /// U is tuned at the first insert and again whenever the live count has doubled since.
+    /// candidates, but more cell changes and deeper trees. The thesis chose 1000 (its table
+    /// 2.1: 2000 marginally faster, 1000 less memory). U is tuned at the first insert and
+    /// the first pair search, and again when the live count has doubled since (at an insert)
+    /// or grown by a quarter (at a pair search); a changed U rebuilds the trees.
     int divisions = 1000;
     /// A fixed leaf width U > 0 instead of tuning; 0 (the default) tunes from the scene.
     double unit = 0;
@@ -27,7 +28,8 @@ struct SegmentTreeSettings {
         Stabbing,     ///< one stabbing path per object on the cheapest axis (default)
         ThesisFlags,  ///< the thesis's per-axis flag walk, for comparison
     };
-    /// How candidate pairs are found; both give the same set.
+    /// How candidate pairs are found; both give the same set. With Stabbing only the
+    /// stabbing axis's tree is kept current each frame (the others catch up when chosen).
     Traversal traversal = Traversal::Stabbing;
     /// With Stabbing: keep the candidate set between frames and update it from the objects
     /// whose cell box changed, while few did (default). false: enumerate every frame.
