@@ -360,6 +360,16 @@ void progress(const std::string& what) {
     }
 }
 
+kolize::ThesisSceneSettings sceneFor(const Options& options, ThesisLayout layout,
+                                     ThesisMotion motion, int n) {
+    kolize::ThesisSceneSettings settings;
+    settings.layout = layout;
+    settings.motion = motion;
+    settings.objects = n;
+    settings.seed = options.seed;
+    return settings;
+}
+
 /// The thesis's S sweep (its tables 2.1 and 2.2): every tree broadphase with each S, the
 /// frame time against the cost of quantisation (candidates the exact test rejected).
 void sweepDivisions(const Options& options, const std::vector<Entry>& entries) {
@@ -374,11 +384,8 @@ void sweepDivisions(const Options& options, const std::vector<Entry>& entries) {
     for (ThesisLayout layout : options.layouts) {
         for (ThesisMotion motion : options.motions) {
             for (int n : options.counts) {
-                kolize::ThesisSceneSettings sceneSettings;
-                sceneSettings.layout = layout;
-                sceneSettings.motion = motion;
-                sceneSettings.objects = n;
-                sceneSettings.seed = options.seed;
+                const kolize::ThesisSceneSettings sceneSettings =
+                    sceneFor(options, layout, motion, n);
                 std::printf("\nscene %s, %s motion, N = %d, %d frames\n",
                             kolize::layoutName(layout), kolize::motionName(motion), n,
                             options.frames);
@@ -469,11 +476,8 @@ int main(int argc, char** argv) {
     for (ThesisLayout layout : options.layouts) {
         for (ThesisMotion motion : options.motions) {
             for (int n : options.counts) {
-                kolize::ThesisSceneSettings sceneSettings;
-                sceneSettings.layout = layout;
-                sceneSettings.motion = motion;
-                sceneSettings.objects = n;
-                sceneSettings.seed = options.seed;
+                const kolize::ThesisSceneSettings sceneSettings =
+                    sceneFor(options, layout, motion, n);
                 const int frames = n >= 100000 ? std::min(options.frames, 15) : options.frames;
                 std::vector<Row> rows;
                 for (const Entry& entry : entries) {

@@ -226,6 +226,16 @@ class CellCore {
     /// The cell box of live object `id`.
     const CellBox<D>& cellsOf(ObjectId id) const { return cells_[id]; }
 
+    /// Calls `visit(id)` once for every live object whose cell box overlaps the cells of
+    /// `box` (derived().visitCells: the segment-tree set walks one current tree, the range
+    /// tree its tree with the sorted-list windows).
+    template <class Visit>
+    void queryBox(const Box& box, Visit&& visit) const {
+        if (!live_.empty()) {
+            derived().visitCells(cellsForQuery(box), visit);
+        }
+    }
+
     /// Calls `visit(id)` once for every live object whose cells meet the ray's bounds; the
     /// adapter's exact test does the rest. A ray longer than 16 cells is cut into pieces of
     /// about 16 cells (at most 1024), each queried through its own bounds, so that a long

@@ -63,15 +63,6 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         this->emitCandidates(candidate);
     }
 
-    /// Calls `visit(id)` once for every live object whose cell box overlaps the cells of
-    /// `box`.
-    template <class Visit>
-    void queryBox(const Box& box, Visit&& visit) const {
-        if (this->size() > 0) {
-            visitCells(this->cellsForQuery(box), visit);
-        }
-    }
-
     /// Checks the tree, the entries, and that every node not awaiting a sort is sorted and
     /// knows its widest entry; throws std::logic_error.
     void validate() const {

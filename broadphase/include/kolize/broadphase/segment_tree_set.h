@@ -65,15 +65,6 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
         this->emitCandidates(candidate);
     }
 
-    /// Calls `visit(id)` once for every live object whose cell box overlaps the cells of
-    /// `box`. Walks one current tree (the narrowest axis of the query among them).
-    template <class Visit>
-    void queryBox(const Box& box, Visit&& visit) const {
-        if (this->size() > 0) {
-            visitCells(this->cellsForQuery(box), visit);
-        }
-    }
-
     /// Checks every tree against the objects' cell boxes; throws std::logic_error.
     void validate() const {
         this->validateObjects("SegmentTreeSet");
