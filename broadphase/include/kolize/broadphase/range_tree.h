@@ -8,7 +8,9 @@
 /// axes. They are found by stabbing on the tree axis (SegmentTree::forEachStab), but in each
 /// node on the path only the window of entries that can overlap on the sorted axis is read:
 /// the entries whose first cell lies in [lo - widest, hi], found by binary search. So the
-/// work is the pairs overlapping on two axes, not on one.
+/// work is the pairs overlapping on two axes, not on one. Like the segment-tree set, it keeps
+/// the candidate set between frames while few objects change cells (CellCore); its queries
+/// of grown slabs use the same windows.
 ///
 /// Upkeep, as the thesis describes: an object that keeps its tree-axis range is edited in
 /// place and its nodes are marked for re-sorting; nodes are re-sorted by insertion sort at
