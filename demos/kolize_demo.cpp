@@ -4,6 +4,7 @@
 
 #include <kolize/engine/falling_boxes.h>
 #include <kolize/engine/pair_compare.h>
+#include <kolize/engine/statistics.h>
 #include <kolize/engine/pair_stream.h>
 #include <kolize/kolize.h>
 
@@ -105,13 +106,7 @@ Options parse(int argc, char** argv) {
     return options;
 }
 
-double median(std::vector<double> values) {
-    if (values.empty()) {
-        return 0;
-    }
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    return values[values.size() / 2];
-}
+using kolize::median;
 
 struct Row {
     std::string broadphase;
@@ -175,9 +170,9 @@ Row runWorld(const std::string& name, const FallingBoxesSettings& settings, int 
 
 void printTable(const std::string& title, const std::vector<Row>& rows) {
     std::printf("\n%s\n", title.c_str());
-    std::printf("| %-12s | %14s | %20s | %8s | %15s | %15s |\n", "broadphase", "median step ms",
+    std::printf("| %-13s | %14s | %20s | %8s | %15s | %15s |\n", "broadphase", "median step ms",
                 "median broadphase ms", "pairs", "false negatives", "false positives");
-    std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(14, '-').c_str(), std::string(16, '-').c_str(),
+    std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(15, '-').c_str(), std::string(16, '-').c_str(),
                 std::string(22, '-').c_str(), std::string(10, '-').c_str(),
                 std::string(17, '-').c_str(), std::string(17, '-').c_str());
     for (const Row& row : rows) {
@@ -186,7 +181,7 @@ void printTable(const std::string& title, const std::vector<Row>& rows) {
         if (row.stepMs >= 0) {
             std::snprintf(step, sizeof step, "%.3f", row.stepMs);
         }
-        std::printf("| %-12s | %14s | %20.3f | %8zu | %15zu | %15zu |\n", row.broadphase.c_str(),
+        std::printf("| %-13s | %14s | %20.3f | %8zu | %15zu | %15zu |\n", row.broadphase.c_str(),
                     step, row.broadphaseMs, row.pairs, row.falseNegatives, row.falsePositives);
     }
     std::fflush(stdout);

@@ -8,6 +8,7 @@
 
 #include <kolize/broadphase/bullet_adapter.h>
 #include <kolize/engine/pair_compare.h>
+#include <kolize/engine/statistics.h>
 #include <kolize/engine/thesis_scene.h>
 #include <kolize/kolize.h>
 
@@ -245,13 +246,7 @@ Options parse(int argc, char** argv) {
     return options;
 }
 
-double median(std::vector<double> values) {
-    if (values.empty()) {
-        return 0;
-    }
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    return values[values.size() / 2];
-}
+using kolize::median;
 
 struct Row {
     std::string label;

@@ -15,6 +15,7 @@
 #include <kolize/broadphase/pair_set.h>
 #include <kolize/broadphase/range_tree.h>
 #include <kolize/broadphase/segment_tree_set.h>
+#include <kolize/engine/statistics.h>
 #include <kolize/engine/thesis_scene.h>
 
 #include <box2d/b2_broad_phase.h>
@@ -57,10 +58,7 @@ double msSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-double median(std::vector<double> values) {
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    return values[values.size() / 2];
-}
+using kolize::median;
 
 struct Result {
     double initMs = 0;

@@ -1,4 +1,5 @@
 #include <kolize/engine/pair_stream.h>
+#include <kolize/engine/statistics.h>
 
 #include <kolize/kolize.h>
 
@@ -246,15 +247,11 @@ std::size_t ReplayResult::totalExtra() const {
 }
 
 double ReplayResult::medianFrameSeconds() const {
-    if (frames.empty()) {
-        return 0;
-    }
     std::vector<double> times;
     for (const ReplayFrame& frame : frames) {
         times.push_back(frame.updateSeconds + frame.pairSeconds);
     }
-    std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-    return times[times.size() / 2];
+    return median(times);
 }
 
 ReplayResult replay(const PairStream& stream, std::string_view name,

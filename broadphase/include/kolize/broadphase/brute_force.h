@@ -6,6 +6,7 @@
 /// the library as the oracle (broadphase name "brute-force").
 
 #include <kolize/broadphase/aabb.h>
+#include <kolize/broadphase/live_ids.h>
 
 #include <stdexcept>
 #include <string>
@@ -25,34 +26,22 @@ class BruteForce {
     explicit BruteForce(const Settings& = {}) {}
 
     /// Adds object `id` (ids are dense; `id` must not be live).
-    void insert(ObjectId id, const Box& /*box*/) {
-        if (id >= position_.size()) {
-            position_.resize(id + 1, kAbsent);
-        }
-        position_[id] = static_cast<std::uint32_t>(live_.size());
-        live_.push_back(id);
-    }
+    void insert(ObjectId id, const Box& /*box*/) { live_.insert(id); }
 
     /// Nothing to do: the brute-force core keeps no geometry.
     void update(ObjectId /*id*/, const Box& /*box*/) {}
 
     /// Removes live object `id` in O(1).
-    void remove(ObjectId id) {
-        const std::uint32_t at = position_[id];
-        const ObjectId last = live_.back();
-        live_[at] = last;
-        position_[last] = at;
-        live_.pop_back();
-        position_[id] = kAbsent;
-    }
+    void remove(ObjectId id) { live_.remove(id); }
 
     /// Calls `candidate(a, b)` once for every unordered pair of live objects.
     template <class Sink>
     void findCandidates(Sink&& candidate) const {
-        const std::size_t n = live_.size();
+        const std::vector<ObjectId>& ids = live_.ids();
+        const std::size_t n = ids.size();
         for (std::size_t i = 0; i < n; ++i) {
             for (std::size_t j = i + 1; j < n; ++j) {
-                candidate(live_[i], live_[j]);
+                candidate(ids[i], ids[j]);
             }
         }
     }
@@ -76,32 +65,13 @@ class BruteForce {
     std::size_t size() const { return live_.size(); }
 
     /// Checks that the live list and the position index agree; throws std::logic_error.
-    void validate() const {
-        std::size_t present = 0;
-        for (std::size_t id = 0; id < position_.size(); ++id) {
-            if (position_[id] == kAbsent) {
-                continue;
-            }
-            ++present;
-            if (position_[id] >= live_.size() || live_[position_[id]] != id) {
-                throw std::logic_error("BruteForce: position index broken at id " +
-                                       std::to_string(id));
-            }
-        }
-        if (present != live_.size()) {
-            throw std::logic_error("BruteForce: live list and index disagree");
-        }
-    }
+    void validate() const { live_.validate("BruteForce"); }
 
     /// Bytes held by the core.
-    std::size_t memoryBytes() const {
-        return live_.capacity() * sizeof(ObjectId) + position_.capacity() * sizeof(std::uint32_t);
-    }
+    std::size_t memoryBytes() const { return live_.memoryBytes(); }
 
   private:
-    static constexpr std::uint32_t kAbsent = 0xffffffffu;
-    std::vector<ObjectId> live_;
-    std::vector<std::uint32_t> position_;
+    LiveIds live_;
 };
 
 }  // namespace kolize

@@ -20,6 +20,7 @@
 /// per object) costs a few comparisons; only a changed cell box reaches the derived core.
 
 #include <kolize/broadphase/aabb.h>
+#include <kolize/broadphase/live_ids.h>
 #include <kolize/broadphase/segment_tree.h>
 
 #include <array>
@@ -169,11 +170,9 @@ class CellCore {
             cells_.resize(id + 1);
             stay_.resize(id + 1);
             changeIndex_.resize(id + 1, 0);
-            position_.resize(id + 1, kAbsent);
         }
         boxes_[id] = box;
-        position_[id] = static_cast<std::uint32_t>(live_.size());
-        live_.push_back(id);
+        live_.insert(id);
         if ((!built_ || live_.size() >= 2 * tunedCount_) && retune()) {
             return;  // rebuilt, `id` included
         }
@@ -204,12 +203,7 @@ class CellCore {
     void remove(ObjectId id) {
         derived().unstore(id);
         noteRemoval(id);
-        const std::uint32_t at = position_[id];
-        const ObjectId last = live_.back();
-        live_[at] = last;
-        position_[last] = at;
-        live_.pop_back();
-        position_[id] = kAbsent;
+        live_.remove(id);
         tunedCount_ = std::min(tunedCount_, live_.size());
     }
 
@@ -376,15 +370,8 @@ class CellCore {
 
     /// Checks the live list, and that every live object's cell box is what its box maps to.
     void validateObjects(const std::string& what) const {
-        std::size_t present = 0;
-        for (std::size_t id = 0; id < position_.size(); ++id) {
-            if (position_[id] == kAbsent) {
-                continue;
-            }
-            ++present;
-            if (position_[id] >= live_.size() || live_[position_[id]] != id) {
-                throw std::logic_error(what + ": live list broken at id " + std::to_string(id));
-            }
+        live_.validate(what);
+        for (ObjectId id : live_) {
             if (cells_[id] != clamped(rawCells(boxes_[id]))) {
                 throw std::logic_error(what + ": cell box of object " + std::to_string(id) +
                                        " is not its box's cells in the current windows");
@@ -395,9 +382,6 @@ class CellCore {
                                            std::to_string(id));
                 }
             }
-        }
-        if (present != live_.size()) {
-            throw std::logic_error(what + ": live list and index disagree");
         }
     }
 
@@ -413,22 +397,20 @@ class CellCore {
         };
     }
 
-    bool isLive(ObjectId id) const { return id < position_.size() && position_[id] != kAbsent; }
+    bool isLive(ObjectId id) const { return live_.contains(id); }
 
     std::size_t objectMemoryBytes() const {
         return boxes_.capacity() * sizeof(Box) + cells_.capacity() * sizeof(CellBox<D>) +
-               stay_.capacity() * sizeof(Stay) +
-               (position_.capacity() + live_.capacity() + changeIndex_.capacity()) *
-                   sizeof(std::uint32_t) +
+               stay_.capacity() * sizeof(Stay) + live_.memoryBytes() +
+               changeIndex_.capacity() * sizeof(std::uint32_t) +
                scratch_.capacity() * sizeof(double) + kept_.capacity() * sizeof(KeptPair) +
                changes_.capacity() * sizeof(Change) + removed_.capacity() * sizeof(ObjectId);
     }
 
-    const std::vector<ObjectId>& live() const { return live_; }
+    const std::vector<ObjectId>& live() const { return live_.ids(); }
     const CellBox<D>& cells(ObjectId id) const { return cells_[id]; }
 
   private:
-    static constexpr std::uint32_t kAbsent = 0xffffffffu;
     /// The kept set is updated when at most 1 / kIncrementalShare of the objects changed
     /// cells; changes beyond 1 / kKeepShare are not recorded and the next frame enumerates
     /// everything without keeping it (fast motion: keeping would not pay).
@@ -681,7 +663,7 @@ class CellCore {
     /// Tunes U for the live objects; when it changed, rebuilds the trees with every live
     /// object and returns true.
     bool retune() {
-        const TunedScene scene = tuneScene(boxes_, live_, tuning_, scratch_);
+        const TunedScene scene = tuneScene(boxes_, live_.ids(), tuning_, scratch_);
         tunedCount_ = live_.size();
         if (built_ && scene.unit == quantizer_.unit()) {
             return false;
@@ -720,8 +702,7 @@ class CellCore {
     std::vector<CellBox<D>> cells_;
     std::vector<Stay> stay_;
     CellBox<D> window_;  ///< the trees' windows, see refreshWindows
-    std::vector<std::uint32_t> position_;
-    std::vector<ObjectId> live_;
+    LiveIds live_;
     std::vector<double> scratch_;
 
     bool incremental_;
