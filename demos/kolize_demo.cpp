@@ -152,7 +152,7 @@ Row runWorld(const std::string& name, const FallingBoxesSettings& settings, int 
         stepMs.push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count());
-        broadphaseMs.push_back(1000 * scene.world().lastBroadphaseSeconds());
+        broadphaseMs.push_back(1000 * scene.lastBroadphaseSeconds());
         const std::vector<kolize::UidPair> reported = kolize::cachedPairs(*cache);
         const kolize::PairDifference difference =
             kolize::comparePairs(kolize::exactPairs(scene.proxyBoxes(), cache), reported);
