@@ -9,6 +9,7 @@
 #include <kolize/broadphase/bullet_adapter.h>
 #include <kolize/engine/pair_compare.h>
 #include <kolize/engine/statistics.h>
+#include <kolize/engine/store_only.h>
 #include <kolize/engine/thesis_scene.h>
 #include <kolize/kolize.h>
 
@@ -54,8 +55,10 @@ const char* kUsage =
     "                           every frame), range-tree:lists=whole (scan node lists whole).\n"
     "                           Default: the kolize broadphases,\n"
     "                           grid:per-axis=17 and spatial-tree:per-axis=17 (the thesis's\n"
-    "                           configuration), dbvt, sap, sap-noray, sap32, brute-force.\n"
-    "                           Names: %s\n"
+    "                           configuration), dbvt, sap, sap-noray, sap32, brute-force,\n"
+    "                           store-only (the lower bound: stores the boxes, finds no\n"
+    "                           pairs; column x store-only = frame time / store-only's).\n"
+    "                           Names: %s, store-only\n"
     "  --s-sweep LIST           the thesis's S sweep (tables 2.1, 2.2) instead: each tree\n"
     "                           broadphase given (default segment-trees, range-tree) with\n"
     "                           divisions = each S; prints frame time, candidates, pairs and\n"
@@ -117,8 +120,10 @@ Entry parseEntry(const std::string& text) {
     const std::vector<std::string> parts = split(text, ':');
     entry.name = parts.empty() ? "" : parts[0];
     const auto& names = kolize::broadphaseNames();
-    if (std::find(names.begin(), names.end(), entry.name) == names.end()) {
-        fail("unknown broadphase '" + entry.name + "'; valid: " + kolize::broadphaseNameList());
+    if (std::find(names.begin(), names.end(), entry.name) == names.end() &&
+        !kolize::isStoreOnly(entry.name)) {
+        fail("unknown broadphase '" + entry.name + "'; valid: " + kolize::broadphaseNameList() +
+             ", store-only");
     }
     for (std::size_t i = 1; i < parts.size(); ++i) {
         const std::vector<std::string> keyValue = split(parts[i], '=');
@@ -236,8 +241,9 @@ Options parse(int argc, char** argv) {
                 broadphases.push_back(name);
             }
         }
-        broadphases.insert(broadphases.end(), {"grid:per-axis=17", "spatial-tree:per-axis=17",
-                                               "dbvt", "sap", "sap-noray", "sap32", "brute-force"});
+        broadphases.insert(broadphases.end(),
+                           {"grid:per-axis=17", "spatial-tree:per-axis=17", "dbvt", "sap",
+                            "sap-noray", "sap32", "brute-force", "store-only"});
     }
     options.broadphases = broadphases;
     for (const std::string& text : broadphases) {
@@ -296,7 +302,7 @@ Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, in
     settings.maxProxies = std::max(n + 2, 2);
     kolize::bench::resetPeak();
     std::unique_ptr<btBroadphaseInterface> broadphase =
-        kolize::makeBroadphase(entry.name, settings);
+        kolize::makeMeasuredBroadphase(entry.name, settings);
     std::vector<btBroadphaseProxy*> proxies(static_cast<std::size_t>(n));
     const Clock::time_point initStart = Clock::now();
     for (int i = 0; i < n; ++i) {
@@ -345,7 +351,7 @@ Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, in
 }
 
 bool isBullet(const std::string& name) {
-    return !kolize::isExactBroadphase(name) && name != "simple";
+    return !kolize::isExactBroadphase(name) && name != "simple" && !kolize::isStoreOnly(name);
 }
 
 void progress(const std::string& what) {
@@ -457,7 +463,7 @@ int main(int argc, char** argv) {
         }
         std::fprintf(csv,
                      "scene,motion,n,broadphase,skipped,init_ms,frame_ms,ratio_to_best_bullet,"
-                     "pairs,missing,extra,candidates,peak_bytes\n");
+                     "pairs,missing,extra,candidates,peak_bytes,x_store_only\n");
     }
     std::printf(
         "kolize-bench: thesis scenes, Bullet %d, %s precision, seed %u; frame = setAabb "
@@ -491,19 +497,30 @@ int main(int argc, char** argv) {
                         bestName = rows[i].label;
                     }
                 }
+                // The lower bound measured in this run: store-only's frame time.
+                double storeOnly = 0;
+                for (std::size_t i = 0; i < rows.size(); ++i) {
+                    if (rows[i].skipped.empty() && kolize::isStoreOnly(entries[i].name)) {
+                        storeOnly = rows[i].frameMs;
+                    }
+                }
+                auto timesStoreOnly = [&](const Row& row) {
+                    return storeOnly > 0 && row.skipped.empty() ? row.frameMs / storeOnly : 0.0;
+                };
                 std::printf(
                     "\nscene %s, %s motion, N = %d, %d frames (ratio: frame time / best "
                     "of Bullet's, %s)\n",
                     kolize::layoutName(layout), kolize::motionName(motion), n, frames,
                     bestName.empty() ? "none run" : bestName.c_str());
-                std::printf("| %-26s | %9s | %9s | %6s | %8s | %7s | %7s | %10s | %8s |\n",
+                std::printf("| %-26s | %9s | %9s | %6s | %8s | %7s | %7s | %10s | %8s | %7s |\n",
                             "broadphase", "init ms", "frame ms", "ratio", "pairs", "missing",
-                            "extra", "candidates", "peak MiB");
-                std::printf("|%s|%s|%s|%s|%s|%s|%s|%s|%s|\n", std::string(28, '-').c_str(),
+                            "extra", "candidates", "peak MiB", "x store");
+                std::printf("|%s|%s|%s|%s|%s|%s|%s|%s|%s|%s|\n", std::string(28, '-').c_str(),
                             std::string(11, '-').c_str(), std::string(11, '-').c_str(),
                             std::string(8, '-').c_str(), std::string(10, '-').c_str(),
                             std::string(9, '-').c_str(), std::string(9, '-').c_str(),
-                            std::string(12, '-').c_str(), std::string(10, '-').c_str());
+                            std::string(12, '-').c_str(), std::string(10, '-').c_str(),
+                            std::string(9, '-').c_str());
                 for (const Row& row : rows) {
                     if (!row.skipped.empty()) {
                         std::printf("| %-26s | skipped: %s\n", row.label.c_str(),
@@ -513,12 +530,16 @@ int main(int argc, char** argv) {
                         if (kolize::isExactBroadphase(split(row.label, ':')[0])) {
                             std::snprintf(candidates, sizeof candidates, "%zu", row.candidates);
                         }
+                        char store[32] = "-";
+                        if (storeOnly > 0) {
+                            std::snprintf(store, sizeof store, "%.1f", timesStoreOnly(row));
+                        }
                         std::printf(
                             "| %-26s | %9.3f | %9.4f | %6.3f | %8zu | %7zu | %7zu | %10s | %8.2f "
-                            "|\n",
+                            "| %7s |\n",
                             row.label.c_str(), row.initMs, row.frameMs,
                             best > 0 ? row.frameMs / best : 0.0, row.pairs, row.missing, row.extra,
-                            candidates, double(row.peakBytes) / (1024.0 * 1024.0));
+                            candidates, double(row.peakBytes) / (1024.0 * 1024.0), store);
                     }
                     if (row.skipped.empty()) {
                         auto same = [&](const MotionPair& pair) {
@@ -532,11 +553,16 @@ int main(int argc, char** argv) {
                         (motion == ThesisMotion::Slow ? at->slowMs : at->fastMs) = row.frameMs;
                     }
                     if (csv != nullptr) {
-                        std::fprintf(csv, "%s,%s,%d,%s,%s,%.6f,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu\n",
+                        std::fprintf(csv, "%s,%s,%d,%s,%s,%.6f,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,",
                                      kolize::layoutName(layout), kolize::motionName(motion), n,
                                      row.label.c_str(), row.skipped.c_str(), row.initMs,
                                      row.frameMs, best > 0 ? row.frameMs / best : 0.0, row.pairs,
                                      row.missing, row.extra, row.candidates, row.peakBytes);
+                        // x_store_only: empty when store-only did not run.
+                        if (timesStoreOnly(row) > 0) {
+                            std::fprintf(csv, "%.4f", timesStoreOnly(row));
+                        }
+                        std::fprintf(csv, "\n");
                     }
                 }
                 std::fflush(stdout);

@@ -41,13 +41,15 @@ using Clock = std::chrono::steady_clock;
 
 const char* kUsage =
     "usage: kolize-bench-2d [--scene A|B|all] [--motion slow|fast|all] [--n LIST]\n"
-    "                       [--frames F] [--seed S]\n"
+    "                       [--frames F] [--seed S] [--csv FILE]\n"
     "2D thesis scenes; kolize's 2D cores (grid, spatial-tree, spatial-hash, segment-trees,\n"
     "range-tree, brute-force)\n"
     "against Box2D 2.4's b2BroadPhase. Frame = update every object + pair set update;\n"
     "medians over the frames; missing / extra pairs against the exact truth, last frame.\n"
     "Defaults: all scenes and motions, N = 1000,3000,10000, 60 frames (15 at\n"
-    "N >= 100000), seed 1. brute-force is skipped above N = 20000.\n";
+    "N >= 100000), seed 1. brute-force is skipped above N = 20000.\n"
+    "--csv FILE also writes one row per run: scene,motion,n,broadphase,frame_ms,\n"
+    "ratio_to_box2d,pairs,missing,extra,skipped.\n";
 
 [[noreturn]] void fail(const std::string& message) {
     std::fprintf(stderr, "kolize-bench-2d: %s (try --help)\n", message.c_str());
@@ -219,6 +221,7 @@ int main(int argc, char** argv) {
     std::vector<int> counts = {1000, 3000, 10000};
     int frames = 60;
     std::uint32_t seed = 1;
+    std::string csvPath;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
         if (flag == "--help" || flag == "-h") {
@@ -250,9 +253,21 @@ int main(int argc, char** argv) {
             frames = static_cast<int>(whole("--frames", value, 1000000));
         } else if (flag == "--seed") {
             seed = static_cast<std::uint32_t>(whole("--seed", value, 0xffffffffL));
+        } else if (flag == "--csv") {
+            csvPath = value;
         } else {
             fail("unknown option '" + flag + "'");
         }
+    }
+    std::FILE* csv = nullptr;
+    if (!csvPath.empty()) {
+        csv = std::fopen(csvPath.c_str(), "w");
+        if (csv == nullptr) {
+            fail("cannot write '" + csvPath + "'");
+        }
+        std::fprintf(csv,
+                     "scene,motion,n,broadphase,frame_ms,ratio_to_box2d,pairs,missing,extra,"
+                     "skipped\n");
     }
     using Runner = std::function<Result(const kolize::ThesisSceneSettings&, int)>;
     const std::vector<std::pair<std::string, Runner>> runners = {
@@ -303,6 +318,11 @@ int main(int argc, char** argv) {
                 for (const auto& [name, runner] : runners) {
                     if (results.count(name) == 0) {
                         std::printf("| %-13s | skipped: O(N^2)\n", name.c_str());
+                        if (csv != nullptr) {
+                            std::fprintf(csv, "%s,%s,%d,%s,,,,,,O(N^2)\n",
+                                         kolize::layoutName(layout), kolize::motionName(motion), n,
+                                         name.c_str());
+                        }
                         continue;
                     }
                     const Result& result = results[name];
@@ -314,10 +334,19 @@ int main(int argc, char** argv) {
                     std::printf("| %-13s | %9.3f | %9.4f | %6.3f | %8zu | %7zu | %7zu |\n",
                                 name.c_str(), result.initMs, result.frameMs, result.frameMs / box2d,
                                 result.pairs.size(), missing.size(), extra.size());
+                    if (csv != nullptr) {
+                        std::fprintf(csv, "%s,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,\n",
+                                     kolize::layoutName(layout), kolize::motionName(motion), n,
+                                     name.c_str(), result.frameMs, result.frameMs / box2d,
+                                     result.pairs.size(), missing.size(), extra.size());
+                    }
                 }
                 std::fflush(stdout);
             }
         }
+    }
+    if (csv != nullptr && std::fclose(csv) != 0) {
+        fail("cannot write '" + csvPath + "'");
     }
     return 0;
 }

@@ -1,5 +1,6 @@
 #include <kolize/engine/pair_stream.h>
 #include <kolize/engine/statistics.h>
+#include <kolize/engine/store_only.h>
 
 #include <kolize/kolize.h>
 
@@ -256,7 +257,7 @@ double ReplayResult::medianFrameSeconds() const {
 
 ReplayResult replay(const PairStream& stream, std::string_view name,
                     const BroadphaseSettings& settings) {
-    std::unique_ptr<btBroadphaseInterface> broadphase = makeBroadphase(name, settings);
+    std::unique_ptr<btBroadphaseInterface> broadphase = makeMeasuredBroadphase(name, settings);
     ReplayResult result;
     result.broadphase = std::string(name);
     std::vector<btBroadphaseProxy*> proxies;

@@ -107,7 +107,8 @@ struct ReplayResult {
     double medianFrameSeconds() const;
 };
 
-/// Replays `stream` into makeBroadphase(name, settings) with a null dispatcher; after each
+/// Replays `stream` into makeMeasuredBroadphase(name, settings) (any broadphase name or
+/// "store-only") with a null dispatcher; after each
 /// frame compares the pair cache with exactPairs over the live proxies.
 /// Throws std::invalid_argument for an unknown name.
 ReplayResult replay(const PairStream& stream, std::string_view name,
