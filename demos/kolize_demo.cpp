@@ -1,11 +1,15 @@
-// kolize-demo: the falling-boxes world (Bullet benchmark style) run with every broadphase,
-// side by side in one process: step time, broadphase time, pairs, and pair errors against
-// the exact truth, checked every frame.
+// kolize-demo: any registered scene (the thesis's streams, Bullet-benchmark worlds, meshes,
+// extreme and stiff cases) run with every chosen broadphase side by side in one process.
+// Per run: init and per-frame times, pairs and their errors against the exact truth checked
+// every frame, the dynamics' health (penetration, escaped bodies, NaN, energy), optionally
+// drift from a fine-step reference, a replay of one recorded stream into every broadphase,
+// and a bit-for-bit comparison with btSimpleBroadphase under deterministic pair order.
 
-#include <kolize/engine/falling_boxes.h>
 #include <kolize/engine/pair_compare.h>
-#include <kolize/engine/statistics.h>
 #include <kolize/engine/pair_stream.h>
+#include <kolize/engine/scene.h>
+#include <kolize/engine/statistics.h>
+#include <kolize/engine/world_scene.h>
 #include <kolize/kolize.h>
 
 #include <btBulletDynamicsCommon.h>
@@ -14,47 +18,131 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace {
 
-using kolize::FallingBoxesSettings;
+using Clock = std::chrono::steady_clock;
 
 const char* kUsage =
     "usage: kolize-demo [options]\n"
-    "  --broadphase NAME|all   broadphase to run (default all): %s\n"
-    "  --frames N              steps per run (default 200)\n"
-    "  --layers N              layers of 8 x 8 boxes (default 47: 3008 boxes)\n"
-    "  --ground box|plane|both static ground (default both)\n"
-    "  --record FILE           record the first run's broadphase calls as a pair stream\n"
-    "  --replay FILE           replay a pair stream into the broadphases instead\n"
-    "  --help                  this text\n";
-
-struct Options {
-    std::vector<std::string> broadphases = kolize::broadphaseNames();
-    int frames = 200;
-    int layers = 47;
-    std::vector<bool> planeGrounds = {false, true};
-    std::string record;
-    std::string replay;
-};
+    "Runs scenes with broadphases side by side; checks every frame's pairs against the exact\n"
+    "AABB pairs and reports times (medians over frames), errors and the dynamics' health.\n"
+    "  --scene NAME|LIST|all     scenes, comma separated (default boxes,boxes-plane)\n"
+    "  --broadphase NAME|LIST|all  broadphases, comma separated (default all)\n"
+    "  --n N                     moving objects (default: the scene's own count)\n"
+    "  --frames F                frames per run (default 200)\n"
+    "  --seed S                  scene seed (default 1)\n"
+    "  --motion slow|fast        speed of the thesis scenes (default slow)\n"
+    "  --timestep T              seconds per frame, e.g. 0.01 or 1/60 (default 1/60)\n"
+    "  --substeps K              solver steps per frame, each T/K (default 1)\n"
+    "  --bullet-ccd auto|on|off  Bullet's own CCD for dynamic bodies (default auto: on in\n"
+    "                            scenes with fast objects)\n"
+    "  --reference-substeps K    also run each scene with K times the substeps and report\n"
+    "                            the bodies' drift from it at the last frame\n"
+    "  --replay-check            record the first broadphase's live run and replay that one\n"
+    "                            stream into every broadphase (identical input)\n"
+    "  --determinism             Bullet's deterministic pair order on; compare every body\n"
+    "                            bit for bit with a run of `simple`, every frame\n"
+    "  --record FILE             record the first run's broadphase calls as a pair stream\n"
+    "  --replay FILE             replay a pair stream into the broadphases instead\n"
+    "  --csv FILE, --json FILE   also write one record per run\n"
+    "  --list-scenes             print the scenes as CSV and exit\n"
+    "  --help                    this text\n"
+    "scenes: %s\n"
+    "broadphases: %s\n";
 
 [[noreturn]] void fail(const std::string& message) {
     std::fprintf(stderr, "kolize-demo: %s (try --help)\n", message.c_str());
     std::exit(2);
 }
 
-int positive(const std::string& flag, const char* text) {
+struct Options {
+    std::vector<std::string> scenes = {"boxes", "boxes-plane"};
+    std::vector<std::string> broadphases = kolize::broadphaseNames();
+    kolize::SceneOptions scene;
+    int frames = 200;
+    int referenceSubsteps = 0;
+    bool replayCheck = false;
+    bool determinism = false;
+    std::string record, replay, csv, json;
+};
+
+long wholeNumber(const std::string& flag, const std::string& text, long low, long high) {
     char* end = nullptr;
-    const long value = std::strtol(text, &end, 10);
-    if (end == text || *end != '\0' || value <= 0 || value > 1000000) {
-        fail(flag + " needs a positive whole number, got '" + text + "'");
+    const long value = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || value < low || value > high) {
+        fail(flag + " needs a whole number in " + std::to_string(low) + ".." +
+             std::to_string(high) + ", got '" + text + "'");
     }
-    return static_cast<int>(value);
+    return value;
+}
+
+double seconds(const std::string& flag, const std::string& text) {
+    const std::size_t slash = text.find('/');
+    char* end = nullptr;
+    double value = std::strtod(text.c_str(), &end);
+    if (slash != std::string::npos && end == text.c_str() + slash) {
+        const char* denominator = text.c_str() + slash + 1;
+        const double divisor = std::strtod(denominator, &end);
+        value = divisor != 0 ? value / divisor : 0;
+    }
+    if (text.empty() || *end != '\0' || !(value > 0) || !(value <= 10)) {
+        fail(flag + " needs a time in seconds in (0, 10], e.g. 0.01 or 1/60, got '" + text + "'");
+    }
+    return value;
+}
+
+std::vector<std::string> list(const std::string& text) {
+    std::vector<std::string> out;
+    std::stringstream stream(text);
+    for (std::string item; std::getline(stream, item, ',');) {
+        out.push_back(item);
+    }
+    return out;
+}
+
+std::vector<std::string> sceneNames() {
+    std::vector<std::string> out;
+    for (const kolize::SceneInfo& info : kolize::sceneList()) {
+        out.push_back(info.name);
+    }
+    return out;
+}
+
+std::vector<std::string> chosen(const std::string& flag, const std::string& text,
+                                const std::vector<std::string>& valid,
+                                const std::string& validText) {
+    if (text == "all") {
+        return valid;
+    }
+    std::vector<std::string> out = list(text);
+    if (out.empty()) {
+        fail(flag + " needs at least one name");
+    }
+    for (const std::string& name : out) {
+        if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
+            fail(flag + ": unknown name '" + name + "'; valid: all, " + validText);
+        }
+    }
+    return out;
+}
+
+void listScenes() {
+    std::printf("name,group,objects,dynamics,rays,meshes,continuous,summary\n");
+    for (const kolize::SceneInfo& info : kolize::sceneList()) {
+        std::printf("%s,%s,%d,%d,%d,%d,%d,\"%s\"\n", info.name.c_str(), info.group.c_str(),
+                    info.defaultObjects, info.needs.dynamics, info.needs.rays, info.needs.meshes,
+                    info.needs.continuous, info.summary.c_str());
+    }
 }
 
 Options parse(int argc, char** argv) {
@@ -62,43 +150,60 @@ Options parse(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
         if (flag == "--help" || flag == "-h") {
-            std::printf(kUsage, kolize::broadphaseNameList().c_str());
+            std::printf(kUsage, kolize::sceneNameList().c_str(),
+                        kolize::broadphaseNameList().c_str());
             std::exit(0);
         }
-        if (i + 1 >= argc) {
-            fail(flag.rfind("--", 0) == 0 ? flag + " needs a value"
-                                          : "unknown argument '" + flag + "'");
+        if (flag == "--list-scenes") {
+            listScenes();
+            std::exit(0);
         }
-        const char* value = argv[++i];
-        if (flag == "--broadphase") {
-            const auto& names = kolize::broadphaseNames();
-            if (std::string(value) == "all") {
-                options.broadphases = names;
-            } else if (std::find(names.begin(), names.end(), value) != names.end()) {
-                options.broadphases = {value};
-            } else {
-                fail(std::string("unknown broadphase '") + value + "'; valid: all, " +
-                     kolize::broadphaseNameList());
-            }
+        if (flag == "--replay-check" || flag == "--determinism") {
+            (flag == "--determinism" ? options.determinism : options.replayCheck) = true;
+            continue;
+        }
+        if (flag.rfind("--", 0) != 0) {
+            fail("unknown argument '" + flag + "'");
+        }
+        if (i + 1 >= argc) {
+            fail(flag + " needs a value");
+        }
+        const std::string value = argv[++i];
+        if (flag == "--scene") {
+            options.scenes = chosen(flag, value, sceneNames(), kolize::sceneNameList());
+        } else if (flag == "--broadphase") {
+            options.broadphases =
+                chosen(flag, value, kolize::broadphaseNames(), kolize::broadphaseNameList());
+        } else if (flag == "--n") {
+            options.scene.objects = int(wholeNumber(flag, value, 1, 10000000));
         } else if (flag == "--frames") {
-            options.frames = positive(flag, value);
-        } else if (flag == "--layers") {
-            options.layers = positive(flag, value);
-        } else if (flag == "--ground") {
-            const std::string ground = value;
-            if (ground == "box") {
-                options.planeGrounds = {false};
-            } else if (ground == "plane") {
-                options.planeGrounds = {true};
-            } else if (ground == "both") {
-                options.planeGrounds = {false, true};
-            } else {
-                fail("--ground takes box, plane or both, got '" + ground + "'");
+            options.frames = int(wholeNumber(flag, value, 1, 1000000));
+        } else if (flag == "--seed") {
+            options.scene.seed = std::uint32_t(wholeNumber(flag, value, 0, 4294967295L));
+        } else if (flag == "--motion") {
+            if (value != "slow" && value != "fast") {
+                fail("--motion takes slow or fast, got '" + value + "'");
             }
+            options.scene.motion = value;
+        } else if (flag == "--timestep") {
+            options.scene.timeStep = seconds(flag, value);
+        } else if (flag == "--substeps") {
+            options.scene.substeps = int(wholeNumber(flag, value, 1, 1000));
+        } else if (flag == "--bullet-ccd") {
+            if (value != "auto" && value != "on" && value != "off") {
+                fail("--bullet-ccd takes auto, on or off, got '" + value + "'");
+            }
+            options.scene.bulletCcd = value == "auto" ? -1 : value == "on" ? 1 : 0;
+        } else if (flag == "--reference-substeps") {
+            options.referenceSubsteps = int(wholeNumber(flag, value, 2, 1000));
         } else if (flag == "--record") {
             options.record = value;
         } else if (flag == "--replay") {
             options.replay = value;
+        } else if (flag == "--csv") {
+            options.csv = value;
+        } else if (flag == "--json") {
+            options.json = value;
         } else {
             fail("unknown option '" + flag + "'");
         }
@@ -106,21 +211,112 @@ Options parse(int argc, char** argv) {
     return options;
 }
 
-using kolize::median;
+// --- one run's record, printed as a table row and written as CSV / JSON ---
 
-struct Row {
-    std::string broadphase;
-    double stepMs = 0;
-    double broadphaseMs = 0;
-    std::size_t pairs = 0;
-    std::size_t falseNegatives = 0;
-    std::size_t falsePositives = 0;
+/// A field: text, and whether JSON writes it as a number.
+struct Field {
+    std::string key;
+    std::string text;
+    bool number = false;
 };
+
+struct Record {
+    std::vector<Field> fields;
+    void text(const std::string& key, const std::string& value) {
+        fields.push_back({key, value, false});
+    }
+    void number(const std::string& key, double value, int decimals = 6) {
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+        fields.push_back({key, buffer, true});
+    }
+    void count(const std::string& key, long long value) {
+        fields.push_back({key, std::to_string(value), true});
+    }
+    /// Not applicable: empty in CSV, null in JSON.
+    void empty(const std::string& key) { fields.push_back({key, "", true}); }
+    const std::string& operator[](const std::string& key) const {
+        static const std::string none;
+        for (const Field& field : fields) {
+            if (field.key == key) {
+                return field.text;
+            }
+        }
+        return none;
+    }
+};
+
+std::string csvQuoted(const std::string& text) {
+    if (text.find_first_of(",\"\n") == std::string::npos) {
+        return text;
+    }
+    std::string out = "\"";
+    for (char c : text) {
+        out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    }
+    return out + "\"";
+}
+
+std::string jsonQuoted(const std::string& text) {
+    std::string out = "\"";
+    for (char c : text) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char buffer[8];
+            std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+            out += buffer;
+        } else {
+            out += c;
+        }
+    }
+    return out + "\"";
+}
+
+void writeFiles(const Options& options, const std::vector<Record>& records) {
+    if (!options.csv.empty()) {
+        std::ofstream out(options.csv);
+        for (std::size_t i = 0; i < records.size() && out; ++i) {
+            if (i == 0) {
+                for (std::size_t j = 0; j < records[i].fields.size(); ++j) {
+                    out << (j ? "," : "") << records[i].fields[j].key;
+                }
+                out << '\n';
+            }
+            for (std::size_t j = 0; j < records[i].fields.size(); ++j) {
+                out << (j ? "," : "") << csvQuoted(records[i].fields[j].text);
+            }
+            out << '\n';
+        }
+        if (!out) {
+            fail("cannot write '" + options.csv + "'");
+        }
+    }
+    if (!options.json.empty()) {
+        std::ofstream out(options.json);
+        out << "[\n";
+        for (std::size_t i = 0; i < records.size(); ++i) {
+            out << "  {";
+            for (std::size_t j = 0; j < records[i].fields.size(); ++j) {
+                const Field& field = records[i].fields[j];
+                out << (j ? ", " : "") << jsonQuoted(field.key) << ": "
+                    << (field.number ? (field.text.empty() ? "null" : field.text)
+                                     : jsonQuoted(field.text));
+            }
+            out << "}" << (i + 1 < records.size() ? "," : "") << "\n";
+        }
+        out << "]\n";
+        if (!out) {
+            fail("cannot write '" + options.json + "'");
+        }
+    }
+}
 
 void progress(const std::string& what, int done, int total) {
     static const bool terminal = isatty(STDERR_FILENO) != 0;
     if (terminal) {
-        std::fprintf(stderr, "\r%-40s %4d/%d", what.c_str(), done, total);
+        std::fprintf(stderr, "\r%-50s %5d/%d", what.c_str(), done, total);
         if (done == total) {
             std::fprintf(stderr, "\n");
         }
@@ -129,87 +325,368 @@ void progress(const std::string& what, int done, int total) {
     }
 }
 
-Row runWorld(const std::string& name, const FallingBoxesSettings& settings, int frames,
-             kolize::PairStream* record) {
-    std::unique_ptr<btBroadphaseInterface> inner = kolize::makeBroadphase(name);
-    std::unique_ptr<btBroadphaseInterface> broadphase;
-    std::unique_ptr<btBroadphaseInterface> keepInner;
-    if (record != nullptr) {
-        broadphase = std::make_unique<kolize::RecordingBroadphase>(*inner, *record);
-        keepInner = std::move(inner);
-    } else {
-        broadphase = std::move(inner);
+// --- running a scene ---
+
+/// Why a broadphase cannot take a scene of `objects` proxies, or empty.
+std::string skipReason(const std::string& name, int objects) {
+    if ((name == "brute-force" || name == "simple") && objects > 20000) {
+        return "O(N^2) per frame above 20000 objects";
     }
-    kolize::FallingBoxesWorld scene(std::move(broadphase), settings);
-    const btOverlappingPairCache* cache = scene.broadphase().getOverlappingPairCache();
-    std::vector<double> stepMs, broadphaseMs;
-    Row row{name};
-    const std::string label =
-        std::string(settings.groundIsPlane ? "plane" : "box") + " ground, " + name;
-    for (int frame = 0; frame < frames; ++frame) {
-        const auto start = std::chrono::steady_clock::now();
-        scene.step();
-        stepMs.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count());
-        broadphaseMs.push_back(1000 * scene.lastBroadphaseSeconds());
-        const std::vector<kolize::UidPair> reported = kolize::cachedPairs(*cache);
-        const kolize::PairDifference difference =
-            kolize::comparePairs(kolize::exactPairs(scene.proxyBoxes(), cache), reported);
-        row.falseNegatives += difference.missing.size();
-        row.falsePositives += difference.extra.size();
-        row.pairs = reported.size();
-        if (frame % 10 == 9 || frame + 1 == frames) {
-            progress(label, frame + 1, frames);
-        }
+    if ((name == "sap" || name == "sap-noray") && objects > 32000) {
+        return "btAxisSweep3 holds at most 32766 proxies";
     }
-    row.stepMs = median(stepMs);
-    row.broadphaseMs = median(broadphaseMs);
-    return row;
+    if (name == "sap32" && objects > 50000) {
+        return "bt32BitAxisSweep3's createProxy is O(N): minutes of init";
+    }
+    return {};
 }
 
-void printTable(const std::string& title, const std::vector<Row>& rows) {
-    std::printf("\n%s\n", title.c_str());
-    std::printf("| %-13s | %14s | %20s | %8s | %15s | %15s |\n", "broadphase", "median step ms",
-                "median broadphase ms", "pairs", "false negatives", "false positives");
-    std::printf("|%s|%s|%s|%s|%s|%s|\n", std::string(15, '-').c_str(), std::string(16, '-').c_str(),
-                std::string(22, '-').c_str(), std::string(10, '-').c_str(),
-                std::string(17, '-').c_str(), std::string(17, '-').c_str());
-    for (const Row& row : rows) {
-        // A replay has no world step: its step column shows "-".
-        char step[32] = "-";
-        if (row.stepMs >= 0) {
-            std::snprintf(step, sizeof step, "%.3f", row.stepMs);
+/// 64-bit FNV-1a over the bytes of every body's transform and velocities.
+std::uint64_t stateHash(kolize::Scene& scene) {
+    std::uint64_t hash = 1469598103934665603ull;
+    auto mix = [&](const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < bytes; ++i) {
+            hash = (hash ^ p[i]) * 1099511628211ull;
         }
-        std::printf("| %-13s | %14s | %20.3f | %8zu | %15zu | %15zu |\n", row.broadphase.c_str(),
-                    step, row.broadphaseMs, row.pairs, row.falseNegatives, row.falsePositives);
+    };
+    const btCollisionObjectArray& objects = scene.world()->getCollisionObjectArray();
+    for (int i = 0; i < objects.size(); ++i) {
+        const btRigidBody* body = btRigidBody::upcast(objects[i]);
+        if (body == nullptr || body->isStaticObject()) {
+            continue;
+        }
+        const btTransform& t = body->getWorldTransform();
+        for (int row = 0; row < 3; ++row) {
+            mix(&t.getBasis()[row], sizeof(btScalar) * 3);
+        }
+        mix(&t.getOrigin(), sizeof(btScalar) * 3);
+        mix(&body->getLinearVelocity(), sizeof(btScalar) * 3);
+        mix(&body->getAngularVelocity(), sizeof(btScalar) * 3);
+    }
+    return hash;
+}
+
+struct RunResult {
+    Record record;
+    std::vector<btVector3> finalPositions;
+    std::vector<std::uint64_t> hashes;  ///< per frame, with --determinism
+};
+
+/// What the demo assembled for a scene, and why.
+void printPipeline(const kolize::SceneInfo& info, const kolize::SceneOptions& options) {
+    const kolize::SceneNeeds& needs = info.needs;
+    std::string stages = needs.dynamics ? "Bullet world (broadphase, narrowphase, solver)"
+                                        : "broadphase stream (setAabb + pair search only)";
+    if (needs.rays) {
+        stages += ", ray casts (timed apart)";
+    }
+    if (needs.meshes) {
+        stages += ", triangle meshes";
+    }
+    const bool ccd = options.bulletCcd < 0 ? needs.continuous : options.bulletCcd > 0;
+    if (needs.dynamics && ccd) {
+        stages += ", Bullet's CCD";
+    }
+    std::printf("pipeline: %s\n  why: %s%s\n", stages.c_str(), info.pipelineWhy.c_str(),
+                needs.dynamics && options.bulletCcd >= 0 && ccd != needs.continuous
+                    ? (ccd ? "; Bullet's CCD on by --bullet-ccd" : "; CCD off by --bullet-ccd")
+                    : "");
+}
+
+RunResult runScene(const std::string& sceneName, const std::string& name,
+                   const kolize::SceneOptions& sceneOptions, const Options& options,
+                   kolize::PairStream* record, bool hashes) {
+    RunResult result;
+    Record& r = result.record;
+    const kolize::SceneInfo& info = kolize::findScene(sceneName);
+    const int objects = sceneOptions.objects > 0 ? sceneOptions.objects : info.defaultObjects;
+    r.text("scene", sceneName);
+    r.text("broadphase", name);
+    r.text("mode", "live");
+    r.text("precision", sizeof(btScalar) == 8 ? "double" : "float");
+    r.count("objects", objects);
+    r.count("frames", options.frames);
+    r.count("seed", sceneOptions.seed);
+    r.text("motion", info.needs.dynamics ? "" : sceneOptions.motion);
+    r.number("timestep", sceneOptions.timeStep, 8);
+    r.count("substeps", sceneOptions.substeps);
+    const bool ccd =
+        sceneOptions.bulletCcd < 0 ? info.needs.continuous : sceneOptions.bulletCcd > 0;
+    r.text("bullet_ccd", !info.needs.dynamics ? "" : ccd ? "on" : "off");
+    const std::string skipped = skipReason(name, objects);
+    if (!skipped.empty()) {
+        r.text("status", "skipped: " + skipped);
+        return result;
+    }
+    try {
+        const kolize::BroadphaseSettings settings =
+            kolize::broadphaseSettingsFor(info, sceneOptions);
+        std::unique_ptr<btBroadphaseInterface> inner = kolize::makeBroadphase(name, settings);
+        std::unique_ptr<btBroadphaseInterface> broadphase;
+        if (record != nullptr) {
+            broadphase = std::make_unique<kolize::RecordingBroadphase>(*inner, *record);
+        } else {
+            broadphase = std::move(inner);
+        }
+        const Clock::time_point initStart = Clock::now();
+        std::unique_ptr<kolize::Scene> scene =
+            kolize::makeScene(sceneName, std::move(broadphase), sceneOptions);
+        const double initMs =
+            std::chrono::duration<double, std::milli>(Clock::now() - initStart).count();
+        if (hashes && scene->world() != nullptr) {
+            scene->world()->getDispatchInfo().m_deterministicOverlappingPairs = true;
+        }
+        const btOverlappingPairCache* cache = scene->broadphase().getOverlappingPairCache();
+        std::vector<double> stepMs, broadphaseMs, rayMs;
+        std::size_t pairs = 0, truePairs = 0, missing = 0, extra = 0, missingFrames = 0;
+        double maxPenetration = 0, energyMax = 0, energyStart = 0;
+        int escaped = 0, nonFinite = 0;
+        const std::string label = sceneName + ", " + name;
+        for (int frame = 0; frame < options.frames; ++frame) {
+            const Clock::time_point start = Clock::now();
+            scene->step();
+            stepMs.push_back(
+                std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+            broadphaseMs.push_back(1000 * scene->lastBroadphaseSeconds());
+            rayMs.push_back(1000 * scene->lastRaySeconds());
+            const std::vector<kolize::UidPair> reported = kolize::cachedPairs(*cache);
+            const std::vector<kolize::UidPair> truth =
+                kolize::exactPairs(scene->proxyBoxes(), scene->filter());
+            const kolize::PairDifference difference = kolize::comparePairs(truth, reported);
+            missing += difference.missing.size();
+            extra += difference.extra.size();
+            missingFrames += difference.missing.empty() ? 0 : 1;
+            pairs = reported.size();
+            truePairs = truth.size();
+            const kolize::SceneState state = scene->state();
+            const double energy = state.kineticEnergy + state.potentialEnergy;
+            if (frame == 0) {
+                energyStart = energyMax = energy;
+            }
+            energyMax = std::max(energyMax, energy);
+            maxPenetration = std::max(maxPenetration, state.maxPenetration);
+            escaped = std::max(escaped, state.escaped);
+            nonFinite = std::max(nonFinite, state.nonFinite);
+            if (hashes && scene->world() != nullptr) {
+                result.hashes.push_back(stateHash(*scene));
+            }
+            if (frame % 10 == 9 || frame + 1 == options.frames) {
+                progress(label, frame + 1, options.frames);
+            }
+        }
+        result.finalPositions = scene->positions();
+        r.number("init_ms", initMs, 3);
+        r.number("step_ms", kolize::median(stepMs), 4);
+        r.number("broadphase_ms", kolize::median(broadphaseMs), 4);
+        if (info.needs.rays) {
+            r.number("ray_ms", kolize::median(rayMs), 4);
+        } else {
+            r.empty("ray_ms");
+        }
+        r.count("pairs", static_cast<long long>(pairs));
+        r.count("true_pairs", static_cast<long long>(truePairs));
+        r.count("missing", static_cast<long long>(missing));
+        r.count("extra", static_cast<long long>(extra));
+        r.count("missing_frames", static_cast<long long>(missingFrames));
+        if (info.needs.dynamics) {
+            r.number("max_penetration", maxPenetration, 6);
+            r.count("escaped", escaped);
+            r.count("nonfinite", nonFinite);
+            r.number("energy_start", energyStart, 3);
+            r.number("energy_max", energyMax, 3);
+        } else {
+            for (const char* key :
+                 {"max_penetration", "escaped", "nonfinite", "energy_start", "energy_max"}) {
+                r.empty(key);
+            }
+        }
+        r.text("status", "ok");
+    } catch (const std::exception& error) {
+        r.text("status", std::string("error: ") + error.what());
+    }
+    return result;
+}
+
+/// Puts the fields in the documented CSV order; absent ones empty.
+Record ordered(const Record& record) {
+    static const char* kKeys[] = {"scene",
+                                  "broadphase",
+                                  "mode",
+                                  "precision",
+                                  "objects",
+                                  "frames",
+                                  "seed",
+                                  "motion",
+                                  "timestep",
+                                  "substeps",
+                                  "bullet_ccd",
+                                  "init_ms",
+                                  "step_ms",
+                                  "broadphase_ms",
+                                  "ray_ms",
+                                  "pairs",
+                                  "true_pairs",
+                                  "missing",
+                                  "extra",
+                                  "missing_frames",
+                                  "max_penetration",
+                                  "escaped",
+                                  "nonfinite",
+                                  "energy_start",
+                                  "energy_max",
+                                  "drift_mean",
+                                  "drift_max",
+                                  "identical_to_simple",
+                                  "first_difference_frame",
+                                  "status"};
+    Record out;
+    for (const char* key : kKeys) {
+        bool found = false;
+        for (const Field& field : record.fields) {
+            if (field.key == key) {
+                out.fields.push_back(field);
+                found = true;
+                break;
+            }
+        }
+        if (!found) {
+            out.empty(key);
+        }
+    }
+    return out;
+}
+
+void printTable(const std::string& title, const std::vector<Record>& rows,
+                const kolize::SceneNeeds& needs, bool drift, bool identical) {
+    std::printf("\n%s\n", title.c_str());
+    std::string header = "| broadphase    | init ms  | step ms  | bp ms    |";
+    if (needs.rays) {
+        header += " ray ms   |";
+    }
+    header += " pairs    | true     | missing  | extra    |";
+    if (needs.dynamics) {
+        header += " max pen m | escaped | NaN |";
+    }
+    if (drift) {
+        header += " drift mean m | drift max m |";
+    }
+    if (identical) {
+        header += " = simple   |";
+    }
+    std::printf("%s\n", header.c_str());
+    std::string rule;
+    for (char c : header) {
+        rule += c == '|' ? '|' : '-';
+    }
+    std::printf("%s\n", rule.c_str());
+    for (const Record& row : rows) {
+        const std::string& status = row["status"];
+        if (status != "ok") {
+            std::printf("| %-13s | %s\n", row["broadphase"].c_str(), status.c_str());
+            continue;
+        }
+        auto cell = [&](const char* key, int width) {
+            const std::string& text = row[key];
+            std::printf(" %*s |", width, text.empty() ? "-" : text.c_str());
+        };
+        std::printf("| %-13s |", row["broadphase"].c_str());
+        cell("init_ms", 8);
+        cell("step_ms", 8);
+        cell("broadphase_ms", 8);
+        if (needs.rays) {
+            cell("ray_ms", 8);
+        }
+        cell("pairs", 8);
+        cell("true_pairs", 8);
+        cell("missing", 8);
+        cell("extra", 8);
+        if (needs.dynamics) {
+            cell("max_penetration", 9);
+            cell("escaped", 7);
+            cell("nonfinite", 3);
+        }
+        if (drift) {
+            cell("drift_mean", 12);
+            cell("drift_max", 11);
+        }
+        if (identical) {
+            const std::string& same = row["identical_to_simple"];
+            const std::string& at = row["first_difference_frame"];
+            std::printf(" %-10s |", same == "no"   ? ("no @" + at).c_str()
+                                    : same.empty() ? "-"
+                                                   : same.c_str());
+        }
+        std::printf("\n");
     }
     std::fflush(stdout);
 }
 
-int replayStream(const Options& options) {
+void addDrift(Record& record, const std::vector<btVector3>& positions,
+              const std::vector<btVector3>& reference) {
+    if (positions.empty() || positions.size() != reference.size()) {
+        return;
+    }
+    double sum = 0, worst = 0;
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const double distance = double((positions[i] - reference[i]).length());
+        sum += distance;
+        worst = std::max(worst, distance);
+    }
+    record.number("drift_mean", sum / double(positions.size()), 6);
+    record.number("drift_max", worst, 6);
+}
+
+std::vector<Record> replayRecords(const kolize::PairStream& stream, const Options& options,
+                                  const std::string& sceneName,
+                                  const kolize::BroadphaseSettings& settings) {
+    std::vector<Record> rows;
+    for (const std::string& name : options.broadphases) {
+        Record r;
+        r.text("scene", sceneName);
+        r.text("broadphase", name);
+        r.text("mode", "replay");
+        r.text("precision", sizeof(btScalar) == 8 ? "double" : "float");
+        r.count("frames", static_cast<long long>(stream.frames()));
+        try {
+            const kolize::ReplayResult result = kolize::replay(stream, name, settings);
+            r.number("broadphase_ms", 1000 * result.medianFrameSeconds(), 4);
+            const kolize::ReplayFrame last =
+                result.frames.empty() ? kolize::ReplayFrame{} : result.frames.back();
+            r.count("pairs", static_cast<long long>(last.reportedPairs));
+            r.count("true_pairs", static_cast<long long>(last.truePairs));
+            r.count("missing", static_cast<long long>(result.totalMissing()));
+            r.count("extra", static_cast<long long>(result.totalExtra()));
+            long long missingFrames = 0;
+            for (const kolize::ReplayFrame& frame : result.frames) {
+                missingFrames += frame.missing > 0 ? 1 : 0;
+            }
+            r.count("missing_frames", missingFrames);
+            r.text("status", "ok");
+        } catch (const std::exception& error) {
+            r.text("status", std::string("error: ") + error.what());
+        }
+        progress("replay " + sceneName + ", " + name, 1, 1);
+        rows.push_back(ordered(r));
+    }
+    return rows;
+}
+
+int replayFile(const Options& options) {
     kolize::PairStream stream;
     try {
         stream = kolize::PairStream::load(options.replay);
     } catch (const std::exception& error) {
         fail(error.what());
     }
-    std::vector<Row> rows;
-    for (const std::string& name : options.broadphases) {
-        const kolize::ReplayResult result = kolize::replay(stream, name);
-        Row row{name};
-        row.stepMs = -1;
-        row.broadphaseMs = 1000 * result.medianFrameSeconds();
-        row.pairs = result.frames.empty() ? 0 : result.frames.back().reportedPairs;
-        row.falseNegatives = result.totalMissing();
-        row.falsePositives = result.totalExtra();
-        rows.push_back(row);
-        progress("replay " + name, static_cast<int>(result.frames.size()),
-                 static_cast<int>(result.frames.size()));
-    }
+    const std::vector<Record> rows =
+        replayRecords(stream, options, options.replay, kolize::BroadphaseSettings{});
+    kolize::SceneNeeds needs;
+    needs.dynamics = false;
     printTable("replay of " + options.replay + " (" + std::to_string(stream.frames()) +
-                   " frames; no world step; broadphase ms = setAabb calls + pairs)",
-               rows);
+                   " frames; no world step; bp ms = setAabb calls + pair search)",
+               rows, needs, false, false);
+    writeFiles(options, rows);
     return 0;
 }
 
@@ -217,38 +694,102 @@ int replayStream(const Options& options) {
 
 int main(int argc, char** argv) {
     const Options options = parse(argc, argv);
-    if (!options.replay.empty()) {
-        return replayStream(options);
-    }
-    FallingBoxesSettings settings;
-    settings.layers = options.layers;
-    const int boxes = settings.layers * settings.boxesPerRow * settings.boxesPerRow;
-    std::printf(
-        "kolize-demo: %d falling unit boxes (%d layers of %d x %d), %d frames of 1/60 s, "
-        "Bullet %d, %s precision; false negatives / positives summed over all frames, "
-        "against the exact AABB pairs\n",
-        boxes, settings.layers, settings.boxesPerRow, settings.boxesPerRow, options.frames,
-        btGetVersion(), sizeof(btScalar) == 8 ? "double" : "float");
-    kolize::PairStream stream;
-    bool recorded = false;
-    for (bool plane : options.planeGrounds) {
-        settings.groundIsPlane = plane;
-        std::vector<Row> rows;
-        for (const std::string& name : options.broadphases) {
-            const bool recordThis = !options.record.empty() && !recorded;
-            rows.push_back(
-                runWorld(name, settings, options.frames, recordThis ? &stream : nullptr));
-            recorded = recorded || recordThis;
+    // Fail on an unwritable output before the runs, not after them.
+    for (const std::string& path : {options.csv, options.json}) {
+        if (!path.empty() && !std::ofstream(path)) {
+            fail("cannot write '" + path + "'");
         }
-        printTable(plane ? "ground: static plane (AABB +-1e18)" : "ground: static box", rows);
+    }
+    if (!options.replay.empty()) {
+        return replayFile(options);
+    }
+    std::printf(
+        "kolize-demo: Bullet %d, %s precision, seed %u, %d frames; times are medians "
+        "over frames; missing / extra pairs summed over all frames against the exact "
+        "AABB pairs\n",
+        btGetVersion(), sizeof(btScalar) == 8 ? "double" : "float", options.scene.seed,
+        options.frames);
+    std::vector<Record> all;
+    kolize::PairStream recorded;
+    bool recordedOnce = false;
+    for (const std::string& sceneName : options.scenes) {
+        const kolize::SceneInfo& info = kolize::findScene(sceneName);
+        std::printf("\n== scene %s (%s): %s\n", sceneName.c_str(), info.group.c_str(),
+                    info.summary.c_str());
+        printPipeline(info, options.scene);
+        const bool determinism = options.determinism && info.needs.dynamics;
+        std::vector<std::uint64_t> simpleHashes;
+        if (determinism) {
+            simpleHashes =
+                runScene(sceneName, "simple", options.scene, options, nullptr, true).hashes;
+        }
+        std::vector<btVector3> reference;
+        const bool drift = options.referenceSubsteps > 0 && info.needs.dynamics;
+        kolize::SceneOptions referenceOptions = options.scene;
+        referenceOptions.substeps *= options.referenceSubsteps;
+        std::vector<Record> rows;
+        kolize::PairStream stream;
+        for (std::size_t i = 0; i < options.broadphases.size(); ++i) {
+            const std::string& name = options.broadphases[i];
+            kolize::PairStream* record = nullptr;
+            if (options.replayCheck && i == 0) {
+                record = &stream;
+            } else if (!options.record.empty() && !recordedOnce) {
+                record = &recorded;
+            }
+            recordedOnce = recordedOnce || (record == &recorded);
+            RunResult run = runScene(sceneName, name, options.scene, options, record, determinism);
+            if (drift && run.record["status"] == "ok") {
+                const RunResult fine =
+                    runScene(sceneName, name, referenceOptions, options, nullptr, false);
+                addDrift(run.record, run.finalPositions, fine.finalPositions);
+            }
+            if (determinism && run.record["status"] == "ok") {
+                const auto mismatch = std::mismatch(run.hashes.begin(), run.hashes.end(),
+                                                    simpleHashes.begin(), simpleHashes.end());
+                const bool same =
+                    mismatch.first == run.hashes.end() && mismatch.second == simpleHashes.end();
+                run.record.text("identical_to_simple", same ? "yes" : "no");
+                if (!same) {
+                    run.record.count("first_difference_frame", mismatch.first - run.hashes.begin());
+                }
+            }
+            rows.push_back(ordered(run.record));
+        }
+        char title[160];
+        std::snprintf(title, sizeof title, "scene %s, live, %d objects, step %.5g s x %d substeps",
+                      sceneName.c_str(), std::stoi(rows.front()["objects"]), options.scene.timeStep,
+                      options.scene.substeps);
+        printTable(title, rows, info.needs, drift, determinism);
+        all.insert(all.end(), rows.begin(), rows.end());
+        if (options.replayCheck && !stream.events.empty()) {
+            const std::vector<Record> replayed = replayRecords(
+                stream, options, sceneName, kolize::broadphaseSettingsFor(info, options.scene));
+            kolize::SceneNeeds streamNeeds;
+            streamNeeds.dynamics = false;
+            printTable("scene " + sceneName + ", replay of " + options.broadphases.front() +
+                           "'s recorded stream (" + std::to_string(stream.frames()) +
+                           " pair searches; identical input for every broadphase)",
+                       replayed, streamNeeds, false, false);
+            all.insert(all.end(), replayed.begin(), replayed.end());
+        }
     }
     if (!options.record.empty()) {
         try {
-            stream.save(options.record);
+            recorded.save(options.record);
         } catch (const std::exception& error) {
             fail(error.what());
         }
-        std::printf("\nrecorded %zu frames to %s\n", stream.frames(), options.record.c_str());
+        std::printf("\nrecorded %zu frames to %s\n", recorded.frames(), options.record.c_str());
+    }
+    writeFiles(options, all);
+    int errors = 0;
+    for (const Record& row : all) {
+        errors += row["status"].rfind("error", 0) == 0 ? 1 : 0;
+    }
+    if (errors > 0) {
+        std::fprintf(stderr, "kolize-demo: %d run(s) failed; see the status column\n", errors);
+        return 1;
     }
     return 0;
 }
