@@ -6,6 +6,8 @@
 
 #include "memory_meter.h"
 
+#include "../common/split.h"
+
 #include <kolize/broadphase/bullet_adapter.h>
 #include <kolize/engine/pair_compare.h>
 #include <kolize/engine/statistics.h>
@@ -88,15 +90,7 @@ struct Options {
     std::exit(2);
 }
 
-std::vector<std::string> split(const std::string& text, char separator) {
-    std::vector<std::string> out;
-    std::stringstream stream(text);
-    std::string item;
-    while (std::getline(stream, item, separator)) {
-        out.push_back(item);
-    }
-    return out;
-}
+using kolize::demo::split;
 
 double number(const std::string& what, const std::string& text) {
     char* end = nullptr;

@@ -10,6 +10,8 @@
 // - kolize: update every object, candidates from the core, the exact box test, and the
 //   frame's difference applied to the pair set (what kolize's Bullet adapter does).
 
+#include "../common/split.h"
+
 #include <kolize/broadphase/brute_force.h>
 #include <kolize/broadphase/cell_grid.h>
 #include <kolize/broadphase/pair_set.h>
@@ -193,16 +195,6 @@ Result runBox2d(const kolize::ThesisSceneSettings& settings, int frames) {
     return result;
 }
 
-std::vector<std::string> split(const std::string& text) {
-    std::vector<std::string> out;
-    std::stringstream stream(text);
-    std::string item;
-    while (std::getline(stream, item, ',')) {
-        out.push_back(item);
-    }
-    return out;
-}
-
 long whole(const std::string& flag, const std::string& text, long max) {
     char* end = nullptr;
     const long value = std::strtol(text.c_str(), &end, 10);
@@ -246,7 +238,7 @@ int main(int argc, char** argv) {
             }
         } else if (flag == "--n") {
             counts.clear();
-            for (const std::string& item : split(value)) {
+            for (const std::string& item : kolize::demo::split(value, ',')) {
                 counts.push_back(static_cast<int>(whole("--n", item, 5000000)));
             }
         } else if (flag == "--frames") {

@@ -91,14 +91,6 @@ std::string pairsInOrder(const std::map<std::string, double>& a,
     return std::to_string(here) + "/" + std::to_string(compared);
 }
 
-/// Runs kolize-bench with `args` and --csv data/<name>.csv.
-bool runBench(Context& context, const std::string& name, std::vector<std::string> args,
-              std::string& shown) {
-    args.push_back("--csv");
-    args.push_back((context.data / (name + ".csv")).string());
-    return context.runTool(name, context.bench, args, shown);
-}
-
 /// Gnuplot data lines "x y" for one broadphase of a bench CSV: N against f(row).
 template <class F>
 std::vector<std::string> seriesOverN(const Csv& csv, const std::string& scene,
@@ -163,14 +155,12 @@ void thesisSection(Context& context) {
                                              "sap",
                                              "sap-noray",
                                              "store-only"};
-    std::string shown;
-    const bool ran = runBench(context, "thesis",
-                              {"--n", csvList(ns), "--frames", context.quick ? "10" : "60",
-                               "--broadphase", join(labels, ",")},
-                              shown);
-    context.commands({shown});
-    Csv csv, thesis;
-    if (!ran || !context.load("thesis.csv", csv)) {
+    Csv csv;
+    Csv thesis;
+    if (!context.measure("thesis", context.bench,
+                         {"--n", csvList(ns), "--frames", context.quick ? "10" : "60",
+                          "--broadphase", join(labels, ",")},
+                         csv)) {
         return;
     }
     try {
@@ -325,14 +315,11 @@ void scalingSection(Context& context) {
     const std::vector<std::string> labels = {"grid",          "spatial-tree", "spatial-hash",
                                              "segment-trees", "range-tree",   "dbvt",
                                              "sap",           "store-only"};
-    std::string shown;
-    const bool ran = runBench(context, "scaling",
-                              {"--motion", "slow", "--n", csvList(ns), "--frames",
-                               context.quick ? "5" : "30", "--broadphase", join(labels, ",")},
-                              shown);
-    context.commands({shown});
     Csv csv;
-    if (!ran || !context.load("scaling.csv", csv)) {
+    if (!context.measure("scaling", context.bench,
+                         {"--motion", "slow", "--n", csvList(ns), "--frames",
+                          context.quick ? "5" : "30", "--broadphase", join(labels, ",")},
+                         csv)) {
         return;
     }
     context.add(
@@ -411,14 +398,11 @@ void sweepSection(Context& context) {
     for (const char* name : {"dbvt", "sap", "sap-noray", "store-only"}) {
         labels.push_back(name);
     }
-    std::string shown;
-    const bool ran = runBench(context, "sweep",
-                              {"--motion", "slow", "--n", std::to_string(n), "--frames",
-                               context.quick ? "5" : "30", "--broadphase", join(labels, ",")},
-                              shown);
-    context.commands({shown});
     Csv csv;
-    if (!ran || !context.load("sweep.csv", csv)) {
+    if (!context.measure("sweep", context.bench,
+                         {"--motion", "slow", "--n", std::to_string(n), "--frames",
+                          context.quick ? "5" : "30", "--broadphase", join(labels, ",")},
+                         csv)) {
         return;
     }
     context.add(
@@ -492,7 +476,8 @@ void sweepSection(Context& context) {
             const std::string block = "f" + scene + std::to_string(index++);
             body += dataBlock(block, lines);
             plots += "$" + block + " using 1:2 with points pt " + std::to_string(4 + 2 * index) +
-                     " ps 1.3 lc " + std::to_string(index) + " title \"" + family + "\", $" + block +
+                     " ps 1.3 lc " + std::to_string(index) + " title \"" + family + "\", $" +
+                     block +
                      " using 1:2:3 with labels font \",8\" offset char 0,0.9 notitle, \\\n     ";
         }
         body += dataBlock("front" + scene, frontLines);
@@ -566,14 +551,9 @@ void box2dSection(Context& context) {
     context.heading("2D: kolize's cores against Box2D's dynamic tree");
     const std::vector<int> ns =
         context.quick ? std::vector<int>{1000, 3000} : std::vector<int>{1000, 3000, 10000, 100000};
-    std::string shown;
-    const bool ran = context.runTool("bench2d", context.bench2d,
-                                     {"--n", csvList(ns), "--frames", context.quick ? "5" : "60",
-                                      "--csv", (context.data / "bench2d.csv").string()},
-                                     shown);
-    context.commands({shown});
     Csv csv;
-    if (!ran || !context.load("bench2d.csv", csv)) {
+    if (!context.measure("bench2d", context.bench2d,
+                         {"--n", csvList(ns), "--frames", context.quick ? "5" : "60"}, csv)) {
         return;
     }
     context.add(

@@ -24,6 +24,16 @@ struct SceneList {
     std::map<std::string, std::string> group;
     std::set<std::string> dynamics, rays;
 
+    /// The registered scenes in `subset`, in registry order.
+    std::vector<std::string> among(const std::set<std::string>& subset) const {
+        std::vector<std::string> out;
+        for (const std::string& name : names) {
+            if (subset.count(name) != 0) {
+                out.push_back(name);
+            }
+        }
+        return out;
+    }
     std::vector<std::string> inGroups(const std::set<std::string>& groups) const {
         std::vector<std::string> out;
         for (const std::string& name : names) {
@@ -48,19 +58,6 @@ struct SceneList {
 std::vector<std::string> sizing(const Context& context) {
     return context.quick ? std::vector<std::string>{"--n", "128", "--frames", "20"}
                          : std::vector<std::string>{"--frames", "100"};
-}
-
-/// Runs a kolize-demo with --csv data/<name>.csv and reads the CSV, also after a failed run
-/// when it wrote one (the failure is recorded either way).
-bool runDemo(Context& context, const std::string& name, const fs::path& binary,
-             std::vector<std::string> args, std::string& shown, Csv& csv) {
-    const fs::path path = context.data / (name + ".csv");
-    std::error_code ignored;
-    fs::remove(path, ignored);
-    args.push_back("--csv");
-    args.push_back(path.string());
-    context.runTool(name, binary, args, shown);
-    return fs::exists(path) && context.load(name + ".csv", csv);
 }
 
 /// "exact", "missing / extra", "skipped" or "**error**" for one run.
@@ -104,6 +101,30 @@ std::string sceneByBroadphase(const std::vector<std::string>& scenes,
     return markdownTable(header, rows);
 }
 
+/// The broadphase with the smallest `column` for `scene` in `mode`: "name (x ms)"; with a
+/// reference broadphase also its multiple of that one's. "" when none ran.
+std::string fastest(const Csv& csv, const std::string& scene,
+                    const std::vector<std::string>& broadphases, const std::string& mode,
+                    const std::string& column, const std::string& reference = "") {
+    std::string best;
+    double bestMs = kNaN, referenceMs = kNaN;
+    for (const std::string& broadphase : broadphases) {
+        const long row = find(csv, scene, broadphase, mode);
+        const double ms = row < 0 ? kNaN : csv.number(std::size_t(row), column);
+        referenceMs = broadphase == reference ? ms : referenceMs;
+        if (std::isfinite(ms) && !(ms >= bestMs)) {
+            bestMs = ms;
+            best = broadphase;
+        }
+    }
+    if (best.empty()) {
+        return best;
+    }
+    return best + " (" + fmt(bestMs) + " ms" +
+           (reference.empty() ? "" : ", " + times(bestMs / referenceMs) + " " + reference + "'s") +
+           ")";
+}
+
 std::string orNone(const std::vector<std::string>& items) {
     return items.empty() ? "none" : join(items, "; ");
 }
@@ -140,12 +161,9 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
     std::vector<std::string> args = {"--scene", "all", "--broadphase", "all", "--replay-check"};
     const std::vector<std::string> size = sizing(context);
     args.insert(args.end(), size.begin(), size.end());
-    std::string shown;
-    if (!runDemo(context, "pairs", context.demo, args, shown, pairs)) {
-        context.commands({shown});
+    if (!context.measure("pairs", context.demo, args, pairs)) {
         return;
     }
-    context.commands({shown});
     const std::vector<std::string> broadphases = pairs.distinct("broadphase");
     auto objects = [&](const std::string& scene) {
         const long row = find(pairs, scene, broadphases.front(), "live");
@@ -189,7 +207,7 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
     // Reading: exactness of kolize's broadphases; Bullet's errors; fastest per scene.
     std::map<std::string, int> exact, runs;
     std::map<std::string, double> extraOf, missingOf;
-    std::vector<std::string> differences, errors, fastest;
+    std::vector<std::string> differences, errors, fastestPerScene;
     for (std::size_t r = 0; r < pairs.size(); ++r) {
         const std::string& broadphase = pairs.at(r, "broadphase");
         const std::string& mode = pairs.at(r, "mode");
@@ -214,22 +232,10 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
         }
     }
     for (const std::string& scene : scenes.names) {
-        std::string best;
-        double bestMs = kNaN, dbvtMs = kNaN;
-        for (const std::string& broadphase : broadphases) {
-            const long row = find(pairs, scene, broadphase, "replay");
-            const double ms = row < 0 ? kNaN : pairs.number(row, "broadphase_ms");
-            if (broadphase == "dbvt") {
-                dbvtMs = ms;
-            }
-            if (std::isfinite(ms) && !(ms >= bestMs)) {
-                bestMs = ms;
-                best = broadphase;
-            }
-        }
+        const std::string best =
+            fastest(pairs, scene, broadphases, "replay", "broadphase_ms", "dbvt");
         if (!best.empty()) {
-            fastest.push_back(scene + ": " + best + " (" + fmt(bestMs) + " ms, " +
-                              times(bestMs / dbvtMs) + " dbvt's)");
+            fastestPerScene.push_back(scene + ": " + best);
         }
     }
     std::vector<std::string> bullet;
@@ -243,16 +249,12 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
         " replayed runs; differences: " + orNone(differences) +
         ". Bullet's, summed over scenes and frames: " + orNone(bullet) +
         ". Runs that failed: " + orNone(errors) +
-        ". Fastest broadphase per scene on the replayed stream: " + orNone(fastest) + ".\n");
+        ". Fastest broadphase per scene on the replayed stream: " + orNone(fastestPerScene) +
+        ".\n");
 
     // Rays: only scenes that cast them.
     context.heading("Ray casts");
-    std::vector<std::string> rayScenes;
-    for (const std::string& scene : scenes.names) {
-        if (scenes.rays.count(scene) != 0) {
-            rayScenes.push_back(scene);
-        }
-    }
+    const std::vector<std::string> rayScenes = scenes.among(scenes.rays);
     if (rayScenes.empty()) {
         context.add("No registered scene casts rays, so there are no ray timings.\n");
         return;
@@ -268,29 +270,15 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
             return row < 0 ? std::string("-") : fmt(pairs.number(row, "ray_ms"));
         }));
     for (const std::string& scene : rayScenes) {
-        std::string best;
-        double bestMs = kNaN;
-        for (const std::string& broadphase : broadphases) {
-            const long row = find(pairs, scene, broadphase, "live");
-            const double ms = row < 0 ? kNaN : pairs.number(row, "ray_ms");
-            if (std::isfinite(ms) && !(ms >= bestMs)) {
-                bestMs = ms;
-                best = broadphase;
-            }
-        }
-        rayReading.push_back(scene + ": " + best + " (" + fmt(bestMs) + " ms)");
+        rayReading.push_back(scene + ": " +
+                             fastest(pairs, scene, broadphases, "live", "ray_ms", "dbvt"));
     }
     context.add("\n**Reading:** fastest ray casts: " + orNone(rayReading) + ".\n");
 }
 
 void determinismSection(Context& context, const SceneList& scenes) {
     context.heading("Determinism: bit-identical to `simple`?");
-    std::vector<std::string> dynamic;
-    for (const std::string& scene : scenes.names) {
-        if (scenes.dynamics.count(scene) != 0) {
-            dynamic.push_back(scene);
-        }
-    }
+    const std::vector<std::string> dynamic = scenes.among(scenes.dynamics);
     if (dynamic.empty()) {
         context.add("No registered scene has dynamics.\n");
         return;
@@ -305,11 +293,8 @@ void determinismSection(Context& context, const SceneList& scenes) {
                                      join(broadphases, ","), "--determinism"};
     const std::vector<std::string> size = sizing(context);
     args.insert(args.end(), size.begin(), size.end());
-    std::string shown;
     Csv csv;
-    const bool ran = runDemo(context, "determinism", context.demo, args, shown, csv);
-    context.commands({shown});
-    if (!ran) {
+    if (!context.measure("determinism", context.demo, args, csv)) {
         return;
     }
     context.add(
@@ -403,7 +388,7 @@ void dynamicsSection(Context& context, const SceneList& scenes) {
             }
             std::string shown;
             Csv csv;
-            const bool ran = runDemo(context, name, context.demo, args, shown, csv);
+            const bool ran = context.runCsv(name, context.demo, args, csv, shown);
             commands.push_back(shown);
             if (!ran) {
                 continue;
@@ -519,9 +504,7 @@ void stabilitySection(Context& context, const SceneList& scenes, const Csv& pair
         std::vector<std::string> args = {"--scene", join(chosen, ","), "--broadphase", "all"};
         const std::vector<std::string> size = sizing(context);
         args.insert(args.end(), size.begin(), size.end());
-        std::string shown;
-        haveDouble = runDemo(context, "stability-double", context.doubleDemo, args, shown, doubles);
-        context.commands({shown});
+        haveDouble = context.measure("stability-double", context.doubleDemo, args, doubles);
     } else {
         context.add("*No double-precision column: " + context.doubleDemoNote +
                     " (scripts/report.sh builds one in build-double/).*\n\n");

@@ -99,6 +99,17 @@ bool Context::runTool(const std::string& name, const fs::path& binary,
     return true;
 }
 
+bool Context::runCsv(const std::string& name, const fs::path& binary, std::vector<std::string> args,
+                     Csv& csv, std::string& shown) {
+    const fs::path path = data / (name + ".csv");
+    std::error_code ignored;
+    fs::remove(path, ignored);
+    args.push_back("--csv");
+    args.push_back(path.string());
+    runTool(name, binary, args, shown);
+    return fs::exists(path) && load(name + ".csv", csv);
+}
+
 bool Context::load(const std::string& file, Csv& csv) {
     try {
         csv = Csv::read(data / file);

@@ -34,6 +34,18 @@ struct Context {
     }
     /// Reads data/<file>, or records the problem as a failure and returns false.
     bool load(const std::string& file, Csv& csv);
+    /// Runs `binary` with args + --csv data/<name>.csv and reads that CSV, also after a
+    /// failed run when it wrote one (the failure is recorded either way).
+    bool runCsv(const std::string& name, const fs::path& binary, std::vector<std::string> args,
+                Csv& csv, std::string& shown);
+    /// runCsv, then the command under the section's heading.
+    bool measure(const std::string& name, const fs::path& binary,
+                 const std::vector<std::string>& args, Csv& csv) {
+        std::string shown;
+        const bool loaded = runCsv(name, binary, args, csv, shown);
+        commands({shown});
+        return loaded;
+    }
 };
 
 void thesisSection(Context& context);

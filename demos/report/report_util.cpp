@@ -128,16 +128,6 @@ std::vector<std::string> Csv::distinct(const std::string& column) const {
     return out;
 }
 
-std::vector<std::string> split(const std::string& text, char separator) {
-    std::vector<std::string> out;
-    std::stringstream stream(text);
-    std::string item;
-    while (std::getline(stream, item, separator)) {
-        out.push_back(item);
-    }
-    return out;
-}
-
 std::string join(const std::vector<std::string>& parts, const std::string& separator) {
     std::string out;
     for (std::size_t i = 0; i < parts.size(); ++i) {

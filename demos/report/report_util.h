@@ -2,6 +2,8 @@
 // kolize-report's building blocks: CSV tables, child processes whose failures are recorded,
 // Markdown tables, number formatting, gnuplot.
 
+#include "../common/split.h"
+
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
@@ -39,8 +41,7 @@ class Csv {
     std::vector<std::vector<std::string>> rows_;
 };
 
-/// Splits on a separator (no quoting).
-std::vector<std::string> split(const std::string& text, char separator);
+using kolize::demo::split;
 std::string join(const std::vector<std::string>& parts, const std::string& separator);
 
 /// "1.23", "45.6", "789", "0.00123"; "-" for NaN.
