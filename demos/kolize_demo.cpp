@@ -342,32 +342,6 @@ std::string skipReason(const std::string& name, int objects) {
     return {};
 }
 
-/// 64-bit FNV-1a over the bytes of every body's transform and velocities.
-std::uint64_t stateHash(kolize::Scene& scene) {
-    std::uint64_t hash = 1469598103934665603ull;
-    auto mix = [&](const void* data, std::size_t bytes) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < bytes; ++i) {
-            hash = (hash ^ p[i]) * 1099511628211ull;
-        }
-    };
-    const btCollisionObjectArray& objects = scene.world()->getCollisionObjectArray();
-    for (int i = 0; i < objects.size(); ++i) {
-        const btRigidBody* body = btRigidBody::upcast(objects[i]);
-        if (body == nullptr || body->isStaticObject()) {
-            continue;
-        }
-        const btTransform& t = body->getWorldTransform();
-        for (int row = 0; row < 3; ++row) {
-            mix(&t.getBasis()[row], sizeof(btScalar) * 3);
-        }
-        mix(&t.getOrigin(), sizeof(btScalar) * 3);
-        mix(&body->getLinearVelocity(), sizeof(btScalar) * 3);
-        mix(&body->getAngularVelocity(), sizeof(btScalar) * 3);
-    }
-    return hash;
-}
-
 struct RunResult {
     Record record;
     std::vector<btVector3> finalPositions;
@@ -469,8 +443,9 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
             maxPenetration = std::max(maxPenetration, state.maxPenetration);
             escaped = std::max(escaped, state.escaped);
             nonFinite = std::max(nonFinite, state.nonFinite);
-            if (hashes && scene->world() != nullptr) {
-                result.hashes.push_back(stateHash(*scene));
+            if (const auto* world = dynamic_cast<const kolize::WorldScene*>(scene.get());
+                hashes && world != nullptr) {
+                result.hashes.push_back(world->stateHash());
             }
             if (frame % 10 == 9 || frame + 1 == options.frames) {
                 progress(label, frame + 1, options.frames);

@@ -9,6 +9,7 @@
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <utility>
@@ -61,6 +62,10 @@ class WorldScene : public Scene {
     SceneState state() const override;
     std::vector<btVector3> positions() const override;
     int movingObjects() const override { return dynamicBodies_; }
+
+    /// A 64-bit FNV-1a hash of the bytes of every dynamic body's transform and velocities:
+    /// equal hashes of two runs mean (up to hash collisions) bit-identical states.
+    std::uint64_t stateHash() const;
 
     btCollisionDispatcher& dispatcher() { return *dispatcher_; }
     const std::vector<btRigidBody*>& bodies() const { return bodies_; }
