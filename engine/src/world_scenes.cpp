@@ -28,10 +28,6 @@ using Rng = std::mt19937;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kFar = 1e9;  // "unbounded" side of a container
 
-int objectCount(const SceneInfo& info, const SceneOptions& options) {
-    return options.objects > 0 ? options.objects : info.defaultObjects;
-}
-
 btVector3 vec(double x, double y, double z) {
     return btVector3(btScalar(x), btScalar(y), btScalar(z));
 }
@@ -90,12 +86,21 @@ SceneNeeds needs(bool rays, bool meshes, bool continuous) {
     return out;
 }
 
-std::unique_ptr<WorldScene> newWorld(const SceneInfo& info,
-                                     std::unique_ptr<btBroadphaseInterface> broadphase,
-                                     const SceneOptions& options) {
-    // The scene's world box is centred on its origin: only the offset scenes move it.
+/// Fills a new world with a scene's bodies: `count` is SceneOptions::objects or the default.
+using Filler = void (*)(WorldScene& scene, Rng& rng, int count);
+
+/// A scene's builder: the world (its origin at the scene's world centre: only the offset
+/// scenes move it), the seeded random numbers, then `fill`.
+template <Filler fill>
+std::unique_ptr<Scene> buildWith(const SceneInfo& info,
+                                 std::unique_ptr<btBroadphaseInterface> broadphase,
+                                 const SceneOptions& options) {
     const btScalar c = btScalar(info.worldCentre);
-    return std::make_unique<WorldScene>(info, std::move(broadphase), options, btVector3(c, c, c));
+    auto scene =
+        std::make_unique<WorldScene>(info, std::move(broadphase), options, btVector3(c, c, c));
+    Rng rng(options.seed);
+    fill(*scene, rng, options.objects > 0 ? options.objects : info.defaultObjects);
+    return scene;
 }
 
 // --- static geometry ---
@@ -231,6 +236,18 @@ void addMixedBodies(WorldScene& scene, Rng& rng, int count, double bottom) {
     }
 }
 
+/// `count` random bodies of sizes uniform over minSize..maxSize (mass: size^3 kg) with
+/// centres uniform in the box lo..hi and random orientations: they may start overlapping.
+void addScatteredBodies(WorldScene& scene, Rng& rng, int count, double minSize, double maxSize,
+                        const btVector3& lo, const btVector3& hi) {
+    for (int i = 0; i < count; ++i) {
+        const double size = uniform(rng, minSize, maxSize);
+        btCollisionShape* shape = randomShape(scene, rng, size);
+        const btVector3 position = uniformIn(rng, lo, hi);
+        scene.addBody(shape, size * size * size, at(position, randomRotation(rng)));
+    }
+}
+
 /// The frame's rays over the terrain: 400 vertical ones on a 20 x 20 grid that drifts with
 /// the frame, and 100 long slanted ones across the whole terrain.
 std::vector<WorldRay> terrainRays(int frame) {
@@ -254,36 +271,27 @@ std::vector<WorldRay> terrainRays(int frame) {
 // --- builders ---
 
 /// mixed-terrain, mixed-rays, mixed-plane and the offset scenes (mixed-plane far out).
-std::unique_ptr<Scene> buildMixed(const SceneInfo& info,
-                                  std::unique_ptr<btBroadphaseInterface> broadphase,
-                                  const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    Rng rng(options.seed);
-    const bool terrain = info.needs.meshes;
+void fillMixed(WorldScene& scene, Rng& rng, int count) {
+    const bool terrain = scene.info().needs.meshes;
     if (terrain) {
-        addTerrain(*scene);
+        addTerrain(scene);
         const double margin = 5;
-        scene->setContainer(
+        scene.setContainer(
             vec(-kTerrainHalf - margin, -kTerrainRelief - margin, -kTerrainHalf - margin),
             vec(kTerrainHalf + margin, kFar, kTerrainHalf + margin));
     } else {
-        scene->addBody(scene->own(new btStaticPlaneShape(btVector3(0, 1, 0), 0)), 0,
-                       at(vec(0, 0, 0)));
+        scene.addBody(scene.own(new btStaticPlaneShape(btVector3(0, 1, 0), 0)), 0,
+                      at(vec(0, 0, 0)));
         // The smallest body's centre rests 0.25 m up: 1 m down is through the plane.
-        scene->setContainer(vec(-kFar, -1, -kFar), vec(kFar, kFar, kFar));
+        scene.setContainer(vec(-kFar, -1, -kFar), vec(kFar, kFar, kFar));
     }
-    addMixedBodies(*scene, rng, objectCount(info, options), (terrain ? kTerrainRelief : 0) + 2);
-    if (info.needs.rays) {
-        scene->setRays(terrainRays);
+    addMixedBodies(scene, rng, count, (terrain ? kTerrainRelief : 0) + 2);
+    if (scene.info().needs.rays) {
+        scene.setRays(terrainRays);
     }
-    return scene;
 }
 
-std::unique_ptr<Scene> buildPyramid(const SceneInfo& info,
-                                    std::unique_ptr<btBroadphaseInterface> broadphase,
-                                    const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    const int count = objectCount(info, options);
+void fillPyramid(WorldScene& scene, Rng&, int count) {
     // The smallest base whose full pyramid (sum of side^2) holds count; the top is trimmed.
     int base = 1;
     while (base * (base + 1) * (2 * base + 1) / 6 < count) {
@@ -291,63 +299,46 @@ std::unique_ptr<Scene> buildPyramid(const SceneInfo& info,
     }
     const double pitch = 1.02;  // unit boxes, 2 cm apart within a layer
     const double wall = base * pitch / 2 + 2;
-    addGroundBox(*scene, wall + 10);
-    addWalls(*scene, vec(-wall, 0, -wall), vec(wall, 6, wall), 0.5, false);
-    btCollisionShape* box = scene->own(new btBoxShape(vec(0.5, 0.5, 0.5)));
+    addGroundBox(scene, wall + 10);
+    addWalls(scene, vec(-wall, 0, -wall), vec(wall, 6, wall), 0.5, false);
+    btCollisionShape* box = scene.own(new btBoxShape(vec(0.5, 0.5, 0.5)));
     int placed = 0;
     for (int layer = 0; placed < count; ++layer) {
         const int side = base - layer;
         const double offset = -(side - 1) * pitch / 2;
         for (int cell = 0; cell < side * side && placed < count; ++cell, ++placed) {
-            scene->addBody(box, 1,
-                           at(vec(offset + (cell % side) * pitch, 0.5 + layer,
-                                  offset + (cell / side) * pitch)));
+            scene.addBody(box, 1,
+                          at(vec(offset + (cell % side) * pitch, 0.5 + layer,
+                                 offset + (cell / side) * pitch)));
         }
     }
-    scene->setContainer(vec(-wall, -0.5, -wall), vec(wall, kFar, wall));
-    return scene;
+    scene.setContainer(vec(-wall, -0.5, -wall), vec(wall, kFar, wall));
 }
 
 /// A stack of `count` unit boxes on a ground box; box k (from the bottom) has mass(k).
-std::unique_ptr<Scene> buildStack(const SceneInfo& info,
-                                  std::unique_ptr<btBroadphaseInterface> broadphase,
-                                  const SceneOptions& options,
-                                  const std::function<double(int)>& mass) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    const int count = objectCount(info, options);
-    addGroundBox(*scene, 20);
-    btCollisionShape* box = scene->own(new btBoxShape(vec(0.5, 0.5, 0.5)));
+void addStack(WorldScene& scene, int count, double (*mass)(int)) {
+    addGroundBox(scene, 20);
+    btCollisionShape* box = scene.own(new btBoxShape(vec(0.5, 0.5, 0.5)));
     for (int k = 0; k < count; ++k) {
-        scene->addBody(box, mass(k), at(vec(0, 0.5 + k, 0)));
+        scene.addBody(box, mass(k), at(vec(0, 0.5 + k, 0)));
     }
     // A box whose centre slides 1.5 m sideways has fallen off: the stack did not hold.
-    scene->setContainer(vec(-1.5, -0.5, -1.5), vec(1.5, count + 1, 1.5));
-    return scene;
+    scene.setContainer(vec(-1.5, -0.5, -1.5), vec(1.5, count + 1, 1.5));
 }
 
-std::unique_ptr<Scene> buildTallStack(const SceneInfo& info,
-                                      std::unique_ptr<btBroadphaseInterface> broadphase,
-                                      const SceneOptions& options) {
-    return buildStack(info, std::move(broadphase), options, [](int) { return 1.0; });
+void fillTallStack(WorldScene& scene, Rng&, int count) {
+    addStack(scene, count, [](int) { return 1.0; });
 }
 
-std::unique_ptr<Scene> buildMassRatioStack(const SceneInfo& info,
-                                           std::unique_ptr<btBroadphaseInterface> broadphase,
-                                           const SceneOptions& options) {
-    return buildStack(info, std::move(broadphase), options,
-                      [](int k) { return k % 2 == 0 ? 1.0 : 1000.0; });
+void fillMassRatioStack(WorldScene& scene, Rng&, int count) {
+    addStack(scene, count, [](int k) { return k % 2 == 0 ? 1.0 : 1000.0; });
 }
 
 /// mixed-sizes: sizes log-uniform over 1e-2..1e2 m, shelf-packed (largest first) into
 /// layers over a 600 m square so that no two start overlapping.
-std::unique_ptr<Scene> buildMixedSizes(const SceneInfo& info,
-                                       std::unique_ptr<btBroadphaseInterface> broadphase,
-                                       const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    Rng rng(options.seed);
-    const int count = objectCount(info, options);
+void fillMixedSizes(WorldScene& scene, Rng& rng, int count) {
     constexpr double half = 300;
-    addGroundBox(*scene, half + 100, 10);
+    addGroundBox(scene, half + 100, 10);
     std::vector<double> sizes;
     for (int i = 0; i < count; ++i) {
         sizes.push_back(logUniform(rng, 1e-2, 1e2));
@@ -371,71 +362,45 @@ std::unique_ptr<Scene> buildMixedSizes(const SceneInfo& info,
         }
         rowDepth = std::max(rowDepth, cell);
         layerHeight = std::max(layerHeight, cell);
-        btCollisionShape* shape = randomShape(*scene, rng, size);
+        btCollisionShape* shape = randomShape(scene, rng, size);
         // Mass in kg equal to the size in m: a 1e4 mass ratio instead of uniform density's 1e12.
-        scene->addBody(shape, size,
-                       at(vec(x + cell / 2, y + cell / 2, z + cell / 2), randomRotation(rng)));
+        scene.addBody(shape, size,
+                      at(vec(x + cell / 2, y + cell / 2, z + cell / 2), randomRotation(rng)));
         x += cell;
     }
-    scene->setContainer(vec(-half - 100, -1, -half - 100), vec(half + 100, kFar, half + 100));
-    return scene;
+    scene.setContainer(vec(-half - 100, -1, -half - 100), vec(half + 100, kFar, half + 100));
 }
 
-std::unique_ptr<Scene> buildSmallRegion(const SceneInfo& info,
-                                        std::unique_ptr<btBroadphaseInterface> broadphase,
-                                        const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    Rng rng(options.seed);
+void fillSmallRegion(WorldScene& scene, Rng& rng, int count) {
     const btVector3 min = vec(-2, 0, -2), max = vec(2, 4, 2);
-    addWalls(*scene, min, max, 0.5, true);
+    addWalls(scene, min, max, 0.5, true);
     const btVector3 inset(0.25, 0.25, 0.25);
-    for (int i = 0, count = objectCount(info, options); i < count; ++i) {
-        const double size = uniform(rng, 0.15, 0.5);
-        btCollisionShape* shape = randomShape(*scene, rng, size);
-        const btVector3 position = uniformIn(rng, min + inset, max - inset);
-        scene->addBody(shape, size * size * size, at(position, randomRotation(rng)));
-    }
+    addScatteredBodies(scene, rng, count, 0.15, 0.5, min + inset, max - inset);
     const btVector3 margin(0.5, 0.5, 0.5);
-    scene->setContainer(min - margin, max + margin);
-    return scene;
+    scene.setContainer(min - margin, max + margin);
 }
 
-std::unique_ptr<Scene> buildEscape(const SceneInfo& info,
-                                   std::unique_ptr<btBroadphaseInterface> broadphase,
-                                   const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    Rng rng(options.seed);
-    const int count = objectCount(info, options);
+void fillEscape(WorldScene& scene, Rng& rng, int count) {
+    // No container: leaving is the point.
     for (int i = 0; i < count; ++i) {
         const double size = uniform(rng, kMixedMin, kMixedMax);
-        btCollisionShape* shape = randomShape(*scene, rng, size);
+        btCollisionShape* shape = randomShape(scene, rng, size);
         const btVector3 direction = randomDirection(rng);
         const double distance = uniform(rng, 2, 12);
         // Speeds stratified log-uniformly over 50..5000 m/s: body i in the i-th slice.
         const double speed = 50 * std::pow(100.0, (i + uniform(rng, 0, 1)) / count);
-        scene->addBody(shape, size * size * size,
-                       at(direction * btScalar(distance), randomRotation(rng)),
-                       direction * btScalar(speed));
+        scene.addBody(shape, size * size * size,
+                      at(direction * btScalar(distance), randomRotation(rng)),
+                      direction * btScalar(speed));
     }
-    return scene;  // no container: leaving is the point
 }
 
-std::unique_ptr<Scene> buildDensePile(const SceneInfo& info,
-                                      std::unique_ptr<btBroadphaseInterface> broadphase,
-                                      const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    Rng rng(options.seed);
-    addGroundBox(*scene, 100);
+void fillDensePile(WorldScene& scene, Rng& rng, int count) {
+    addGroundBox(scene, 100);
     // Sizes 6..10 m with centres in a 3 m cube: every AABB is at least 3 m across, so the
     // boxes overlap nearly pairwise.
-    for (int i = 0, count = objectCount(info, options); i < count; ++i) {
-        const double size = uniform(rng, 6, 10);
-        btCollisionShape* shape = randomShape(*scene, rng, size);
-        const btVector3 position = uniformIn(rng, vec(-1.5, 10.5, -1.5), vec(1.5, 13.5, 1.5));
-        scene->addBody(shape, size * size * size, at(position, randomRotation(rng)));
-    }
-    scene->setContainer(vec(-100, -1, -100), vec(100, kFar, 100));
-    return scene;
+    addScatteredBodies(scene, rng, count, 6, 10, vec(-1.5, 10.5, -1.5), vec(1.5, 13.5, 1.5));
+    scene.setContainer(vec(-100, -1, -100), vec(100, kFar, 100));
 }
 
 #ifdef KOLIZE_WITH_ASSIMP
@@ -468,18 +433,13 @@ btCollisionShape* hullShape(WorldScene& scene, const LoadedMesh& mesh, double si
     return scene.own(hull);
 }
 
-std::unique_ptr<Scene> buildMeshes(const SceneInfo& info,
-                                   std::unique_ptr<btBroadphaseInterface> broadphase,
-                                   const SceneOptions& options) {
-    auto scene = newWorld(info, std::move(broadphase), options);
-    Rng rng(options.seed);
+void fillMeshes(WorldScene& scene, Rng& rng, int count) {
     std::vector<btCollisionShape*> hulls;
     for (const char* model : kMeshModels) {
-        hulls.push_back(hullShape(*scene, loadMesh(options.assetDir + "/" + model), 1.5));
+        hulls.push_back(hullShape(scene, loadMesh(scene.options().assetDir + "/" + model), 1.5));
     }
-    const int count = objectCount(info, options);
     const double radius = std::max(6.0, 16 * std::cbrt(count / 200.0));
-    addBowl(*scene, radius);
+    addBowl(scene, radius);
     // Drop columns (corners included) within 0.7 of the radius, where the bowl is 0.29 of
     // the radius high; layers from 2 m above that.
     const double reach = 0.7 * radius - kDropPitch / 2;
@@ -487,13 +447,11 @@ std::unique_ptr<Scene> buildMeshes(const SceneInfo& info,
     const double bottom = radius * (1 - std::sqrt(1 - 0.7 * 0.7)) + 2;
     int i = 0;
     for (const btVector3& position : dropGrid(count, perSide, kDropPitch, bottom)) {
-        scene->addBody(hulls[std::size_t(i++) % hulls.size()], 1,
-                       at(position, randomRotation(rng)));
+        scene.addBody(hulls[std::size_t(i++) % hulls.size()], 1, at(position, randomRotation(rng)));
     }
     const double margin = 1;
-    scene->setContainer(vec(-radius - margin, -margin, -radius - margin),
-                        vec(radius + margin, kFar, radius + margin));
-    return scene;
+    scene.setContainer(vec(-radius - margin, -margin, -radius - margin),
+                       vec(radius + margin, kFar, radius + margin));
 }
 #endif
 
@@ -530,18 +488,18 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "dynamics: the pyramid settles under its weight; no rays: nothing casts; no meshes: "
          "boxes only; no continuous stages: the boxes start at rest in contact",
          0, 20},
-        buildPyramid);
+        buildWith<fillPyramid>);
     add({"mixed-terrain", mixed + " onto a static triangle-mesh terrain (64 x 64 quads, hills)",
          "bullet", 1000, needs(false, true, false), mixedWhy(terrainMesh, false), 0, 45},
-        buildMixed);
+        buildWith<fillMixed>);
     add({"mixed-plane", mixed + " onto a static plane", "bullet", 1000, needs(false, false, false),
          mixedWhy(planeMesh, false), 0, 45},
-        buildMixed);
+        buildWith<fillMixed>);
     add({"mixed-rays",
          "mixed-terrain plus 500 rays per frame: 400 vertical ones on a drifting grid, 100 long "
          "slanted ones",
          "bullet", 1000, needs(true, true, false), mixedWhy(terrainMesh, true), 0, 45},
-        buildMixed);
+        buildWith<fillMixed>);
 #ifdef KOLIZE_WITH_ASSIMP
     add({"meshes",
          "N (default 200) convex hulls of assimp's test models (ThreeCubesGreen, RotatingCube, "
@@ -551,18 +509,18 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "by assimp as convex hulls, the bowl a triangle mesh; no continuous stages: falls of a "
          "few metres move under 0.3 m per step",
          0, 30},
-        buildMeshes);
+        buildWith<fillMeshes>);
 #endif
     add({"offset-1e4", "mixed-plane with every coordinate shifted by (1e4, 1e4, 1e4)", "extreme",
          1000, needs(false, false, false),
          mixedWhy(planeMesh, false) + "; far from the origin: float positions are coarse", 1e4, 45},
-        buildMixed);
+        buildWith<fillMixed>);
     add({"offset-1e6",
          "mixed-plane with every coordinate shifted by (1e6, 1e6, 1e6) (float: positions "
          "in steps of 1/16 m)",
          "extreme", 1000, needs(false, false, false),
          mixedWhy(planeMesh, false) + "; far from the origin: float positions are coarse", 1e6, 45},
-        buildMixed);
+        buildWith<fillMixed>);
     add({"mixed-sizes",
          "N (default 500) boxes, spheres and capsules with sizes log-uniform over 1 cm..100 m "
          "(mass in kg = size in m) stacked in layers up to a few hundred metres, falling onto "
@@ -572,7 +530,7 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "no meshes: primitives and a ground box; continuous: 1 cm bodies falling from hundreds "
          "of metres move far more than their size per step",
          0, 600},
-        buildMixedSizes);
+        buildWith<fillMixedSizes>);
     add({"small-region",
          "N (default 500) boxes, spheres and capsules of 0.15..0.5 m placed at random in a "
          "closed 4 m box, overlapping heavily at the start",
@@ -581,7 +539,7 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "meshes: primitives and wall boxes; no continuous stages: the walls keep the bodies "
          "within a few metres",
          0, 3},
-        buildSmallRegion);
+        buildWith<fillSmallRegion>);
     add({"escape",
          "N (default 300) boxes, spheres and capsules launched outward from a 12 m ball at "
          "50..5000 m/s (log-uniform), gravity on, no walls: kilometres out within 60 frames",
@@ -589,7 +547,7 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "dynamics: bodies collide at the start, then fly apart; no rays: nothing casts; no "
          "meshes: primitives only; continuous: up to 80 m per step",
          0, 15},
-        buildEscape);
+        buildWith<fillEscape>);
     add({"dense-pile",
          "N (default 200) boxes, spheres and capsules of 6..10 m with centres in one 3 m cube "
          "(AABBs overlapping nearly pairwise) above a ground box",
@@ -597,7 +555,7 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "dynamics: the solver pushes a pile of deep overlaps apart; no rays: nothing casts; no "
          "meshes: primitives and a ground box; no continuous stages: bodies are metres across",
          0, 20},
-        buildDensePile);
+        buildWith<fillDensePile>);
     add({"tall-stack",
          "a single stack of N (default 40) unit boxes (1 kg) on a ground box (measured: holds "
          "at 1/60 s with 4 substeps, falls after about 2.5 s with 1 or 2)",
@@ -605,7 +563,7 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "dynamics: the solver must hold the stack; no rays: nothing casts; no meshes: boxes "
          "only; no continuous stages: the boxes start at rest in contact",
          0, 45},
-        buildTallStack);
+        buildWith<fillTallStack>);
     add({"mass-ratio-stack",
          "a stack of N (default 20) unit boxes alternating 1 kg and 1000 kg from the bottom "
          "(1:1000) on a ground box (measured: Bullet's solver lets it collapse)",
@@ -613,7 +571,7 @@ void addWorldScenes(std::vector<SceneEntry>& entries) {
          "dynamics: the solver must hold heavy boxes on light ones; no rays: nothing casts; no "
          "meshes: boxes only; no continuous stages: the boxes start at rest in contact",
          0, 25},
-        buildMassRatioStack);
+        buildWith<fillMassRatioStack>);
 }
 
 }  // namespace kolize
