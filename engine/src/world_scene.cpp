@@ -72,6 +72,11 @@ btCollisionShape* WorldScene::own(btCollisionShape* shape) {
     return shape;
 }
 
+btStridingMeshInterface* WorldScene::ownMesh(btStridingMeshInterface* mesh) {
+    meshes_.emplace_back(mesh);
+    return mesh;
+}
+
 btRigidBody* WorldScene::addBody(btCollisionShape* shape, double mass, const btTransform& transform,
                                  const btVector3& linearVelocity) {
     btTransform shifted = transform;

@@ -16,6 +16,7 @@
 #include <vector>
 
 class btCollisionShape;
+class btStridingMeshInterface;
 class btRigidBody;
 class btCollisionDispatcher;
 class btDefaultCollisionConfiguration;
@@ -75,6 +76,9 @@ class WorldScene : public Scene {
     // --- for builders ---
     /// Takes ownership of a shape; returns it.
     btCollisionShape* own(btCollisionShape* shape);
+    /// Takes ownership of a triangle mesh (kept until after every shape is deleted, for the
+    /// btBvhTriangleMeshShape that refers to it); returns it.
+    btStridingMeshInterface* ownMesh(btStridingMeshInterface* mesh);
     /// Adds a rigid body (mass 0: static) at `transform` shifted by origin(). Dynamic bodies
     /// get Bullet's CCD when it is on (SceneOptions::bulletCcd, or the scene's
     /// SceneNeeds::continuous by default): motion threshold and swept-sphere radius from the
@@ -100,6 +104,7 @@ class WorldScene : public Scene {
     std::unique_ptr<btBroadphaseInterface> broadphase_;
     std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
     std::unique_ptr<TimedDynamicsWorld> world_;
+    std::vector<std::unique_ptr<btStridingMeshInterface>> meshes_;  // before shapes_: outlives them
     std::vector<std::unique_ptr<btCollisionShape>> shapes_;
     std::vector<btRigidBody*> bodies_;
     int dynamicBodies_ = 0;
