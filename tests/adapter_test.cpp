@@ -340,3 +340,86 @@ TEST(PairStream, UnreadableFilesGiveErrorsNamingTheFileAndTheProblem) {
 
 }  // namespace
 }  // namespace kolize
+
+namespace kolize {
+namespace {
+
+// Frames where few boxes move take the incremental search (query the moved boxes, keep the
+// pairs of unmoved ones); frames where many move take the full one. Both must give the exact
+// pairs, through creation, destruction, boxes set to the same value, and filter changes.
+TEST(IncrementalSearch, FewMovedBoxesGiveTheExactPairsLikeAFullSearch) {
+    for (const std::string& name : broadphaseNames()) {
+        if (!isExactBroadphase(name)) {
+            continue;
+        }
+        SCOPED_TRACE(name);
+        auto broadphase = makeBroadphase(name);
+        std::mt19937 random(7);
+        std::uniform_real_distribution<double> position(-20, 20), size(0.2, 3);
+        std::vector<btBroadphaseProxy*> proxies;
+        std::map<const btBroadphaseProxy*, ProxyBox> boxes;
+        static char client;
+        auto randomBox = [&](ProxyBox& box) {
+            const btVector3 lo(btScalar(position(random)), btScalar(position(random)),
+                               btScalar(position(random)));
+            box.aabbMin = lo;
+            box.aabbMax = lo + btVector3(btScalar(size(random)), btScalar(size(random)),
+                                         btScalar(size(random)));
+        };
+        auto create = [&] {
+            ProxyBox box;
+            randomBox(box);
+            box.proxy =
+                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+            boxes[box.proxy] = box;
+        };
+        for (int i = 0; i < 600; ++i) {
+            create();
+        }
+        std::size_t pairsSeen = 0;
+        for (int frame = 0; frame < 150; ++frame) {
+            // Mostly a few movers; every 10th frame most of them move.
+            const int movers = frame % 10 == 9 ? 500 : int(random() % 20);
+            for (int i = 0; i < movers; ++i) {
+                btBroadphaseProxy* proxy = proxies[random() % proxies.size()];
+                ProxyBox& box = boxes[proxy];
+                if (random() % 4 == 0) {  // the same box again: not a move
+                    broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+                    continue;
+                }
+                randomBox(box);
+                broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+            }
+            if (frame % 7 == 3) {
+                const std::size_t at = random() % proxies.size();
+                boxes.erase(proxies[at]);
+                broadphase->destroyProxy(proxies[at], nullptr);
+                proxies.erase(proxies.begin() + long(at));
+                create();
+            }
+            if (frame % 13 == 5) {  // an unmoved proxy stops colliding with group 1
+                proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
+            }
+            broadphase->calculateOverlappingPairs(nullptr);
+            std::vector<ProxyBox> live;
+            for (const auto& entry : boxes) {
+                live.push_back(entry.second);
+            }
+            const btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();
+            const std::vector<UidPair> truth = exactPairs(live, cache);
+            ASSERT_EQ(cachedPairs(*cache), truth) << "frame " << frame;
+            pairsSeen += truth.size();
+        }
+        auto* adapter = dynamic_cast<BroadphaseAdapter*>(broadphase.get());
+        ASSERT_NE(adapter, nullptr);
+        adapter->validate();
+        // Meaningful: pairs existed, and both kinds of search ran many times.
+        EXPECT_GT(pairsSeen, 150u * 20);
+        EXPECT_GT(adapter->stats().incrementalSearches, 100u);
+        EXPECT_LT(adapter->stats().incrementalSearches, 140u);
+    }
+}
+
+}  // namespace
+}  // namespace kolize

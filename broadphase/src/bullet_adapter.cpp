@@ -128,6 +128,7 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
         }
         boxes_.emplace_back();
         state_.push_back(SlotState::Free);
+        movedFlag_.push_back(0);
     }
     Proxy* proxy = proxyOf(slot);
     proxy->m_clientObject = userPtr;
@@ -149,6 +150,7 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
     state_[slot] = SlotState::Live;
     boxes_[slot] = toBox(aabbMin, aabbMax);
     coreInsert(slot, boxes_[slot]);
+    noteMoved(slot);
     return proxy;
 }
 
@@ -207,9 +209,14 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         reportBadAabb("setAabb", *checkedProxy(proxy, "setAabb"), aabbMin, aabbMax, reason);
         return;
     }
+    const Box box = toBox(aabbMin, aabbMax);
+    if (state_[slot] == SlotState::Live && box == boxes_[slot]) {
+        return;  // unchanged (resting and sleeping bodies): nothing to do
+    }
     ours->m_aabbMin = aabbMin;
     ours->m_aabbMax = aabbMax;
-    boxes_[slot] = toBox(aabbMin, aabbMax);
+    boxes_[slot] = box;
+    noteMoved(slot);
     if (state_[slot] == SlotState::Live) {
         coreUpdate(slot, boxes_[slot]);
     } else {
@@ -255,11 +262,17 @@ Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
     return ray;
 }
 
-void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candidates) {
+void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candidates,
+                                    bool incremental) {
     const std::uint32_t stamp = stamp_;
     pairs_.retainIf([&](PairSet::Entry& entry) {
         Proxy* a = proxyOf(entry.first());
         Proxy* b = proxyOf(entry.second());
+        if (entry.stamp != stamp && incremental && !movedFlag_[entry.first()] &&
+            !movedFlag_[entry.second()] && state_[entry.first()] == SlotState::Live &&
+            state_[entry.second()] == SlotState::Live) {
+            entry.stamp = stamp;  // neither box changed: the pair still overlaps
+        }
         if (entry.stamp != stamp) {
             // Destroyed proxies already had their pairs removed by destroyProxy.
             const bool bothAlive = state_[entry.first()] != SlotState::PendingFree &&
@@ -282,6 +295,12 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candid
         return true;
     });
     releasePendingSlots();
+    for (ObjectId slot : moved_) {
+        movedFlag_[slot] = 0;
+    }
+    moved_.clear();
+    framesSinceFullSearch_ = incremental ? framesSinceFullSearch_ + 1 : 0;
+    counters_.incrementalSearches += incremental ? 1 : 0;
     ++counters_.frames;
     counters_.candidatesLastFrame = candidates;
 }
@@ -296,6 +315,8 @@ void BroadphaseAdapter::resetPool(btDispatcher* /*dispatcher*/) {
     freeSlots_.clear();
     pendingFree_.clear();
     pairs_.clear();
+    moved_.clear();
+    movedFlag_.clear();
     nextUid_ = 1;
 }
 
@@ -350,6 +371,13 @@ void BroadphaseAdapter::validate() const {
     }
     if (live + parked != liveCount_ || parked != parkedCount_) {
         fail("live/parked counts disagree with the slot table");
+    }
+    std::size_t flagged = 0;
+    for (std::uint8_t flag : movedFlag_) {
+        flagged += flag;
+    }
+    if (movedFlag_.size() != boxes_.size() || flagged != moved_.size()) {
+        fail("moved list and flags disagree");
     }
     pairs_.validate();
     pairs_.forEach([&](const PairSet::Entry& entry) {

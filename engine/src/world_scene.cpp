@@ -72,6 +72,11 @@ btCollisionShape* WorldScene::own(btCollisionShape* shape) {
     return shape;
 }
 
+btStridingMeshInterface* WorldScene::ownMesh(btStridingMeshInterface* mesh) {
+    meshes_.emplace_back(mesh);
+    return mesh;
+}
+
 btRigidBody* WorldScene::addBody(btCollisionShape* shape, double mass, const btTransform& transform,
                                  const btVector3& linearVelocity) {
     btTransform shifted = transform;
@@ -214,6 +219,29 @@ std::vector<btVector3> WorldScene::positions() const {
         }
     }
     return out;
+}
+
+std::uint64_t WorldScene::stateHash() const {
+    std::uint64_t hash = 1469598103934665603ull;
+    auto mix = [&](const btVector3& v) {
+        const auto* bytes = reinterpret_cast<const unsigned char*>(v.m_floats);
+        for (std::size_t i = 0; i < 3 * sizeof(btScalar); ++i) {
+            hash = (hash ^ bytes[i]) * 1099511628211ull;
+        }
+    };
+    for (const btRigidBody* body : bodies_) {
+        if (body->isStaticObject()) {
+            continue;
+        }
+        const btTransform& transform = body->getWorldTransform();
+        for (int row = 0; row < 3; ++row) {
+            mix(transform.getBasis()[row]);
+        }
+        mix(transform.getOrigin());
+        mix(body->getLinearVelocity());
+        mix(body->getAngularVelocity());
+    }
+    return hash;
 }
 
 }  // namespace kolize

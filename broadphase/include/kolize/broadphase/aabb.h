@@ -21,6 +21,9 @@ template <int D, class Scalar>
 struct Aabb {
     std::array<Scalar, D> lo{};
     std::array<Scalar, D> hi{};
+
+    friend bool operator==(const Aabb& a, const Aabb& b) { return a.lo == b.lo && a.hi == b.hi; }
+    friend bool operator!=(const Aabb& a, const Aabb& b) { return !(a == b); }
 };
 
 /// True when the closed boxes share at least one point. At most 2*D comparisons.

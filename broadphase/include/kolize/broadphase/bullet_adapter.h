@@ -37,6 +37,7 @@ struct AdapterStats {
     std::size_t overlappingPairs = 0;     ///< pairs whose AABBs overlap (before filters)
     std::size_t frames = 0;               ///< calculateOverlappingPairs calls
     std::size_t candidatesLastFrame = 0;  ///< candidate pairs the core produced last frame
+    std::size_t incrementalSearches = 0;  ///< frames that queried only the moved objects
     std::size_t pairsAdded = 0;           ///< addOverlappingPair calls that added, all frames
     std::size_t pairsRemoved = 0;         ///< removeOverlappingPair calls, all frames
     std::size_t badAabbReports = 0;       ///< rejected boxes, all time
@@ -103,18 +104,38 @@ class BroadphaseAdapter : public btBroadphaseInterface {
 
     /// Starts a frame of pair finding: call markOverlap for each overlapping pair once,
     /// then finishPairs.
+    /// True when this pair search may be incremental: only the objects whose box changed
+    /// since the last search (at most a quarter of them) are queried, and the pairs between
+    /// unchanged objects are kept. A full search runs at least every kFullSearchEvery frames
+    /// (the cores re-tune themselves there).
+    bool incrementalSearch() const {
+        return counters_.frames > 0 && framesSinceFullSearch_ < kFullSearchEvery &&
+               moved_.size() * 4 <= liveCount_;
+    }
+    /// Visits every live object whose box changed since the last pair search.
+    template <class Visit>
+    void forEachMoved(Visit&& visit) const {
+        for (ObjectId id : moved_) {
+            if (state_[id] == SlotState::Live) {
+                visit(id);
+            }
+        }
+    }
     void beginPairs() { ++stamp_; }
     void markOverlap(ObjectId a, ObjectId b) {
         bool inserted = false;
         pairs_.findOrInsert(a, b, inserted).stamp = stamp_;
     }
     /// Applies the difference from the previous frame to the pair cache.
-    void finishPairs(btDispatcher* dispatcher, std::size_t candidates);
+    /// Applies the frame's pairs to the pair cache. After an incremental search the pairs
+    /// between two unmoved live objects are kept without being marked.
+    void finishPairs(btDispatcher* dispatcher, std::size_t candidates, bool incremental);
 
   private:
     enum class SlotState : std::uint8_t { Free, Live, Parked, PendingFree };
     static constexpr unsigned kChunkBits = 8;
     static constexpr ObjectId kChunkMask = (1u << kChunkBits) - 1;
+    static constexpr std::size_t kFullSearchEvery = 64;
 
     Proxy* checkedProxy(btBroadphaseProxy* proxy, const char* operation) const;
     void releasePendingSlots();
@@ -137,8 +158,18 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     std::size_t liveCount_ = 0;
     std::size_t parkedCount_ = 0;
 
+    void noteMoved(ObjectId slot) {
+        if (!movedFlag_[slot]) {
+            movedFlag_[slot] = 1;
+            moved_.push_back(slot);
+        }
+    }
+
     PairSet pairs_;
     std::uint32_t stamp_ = 0;
+    std::vector<ObjectId> moved_;          ///< slots whose box changed since the last search
+    std::vector<std::uint8_t> movedFlag_;  ///< per slot: in moved_
+    std::size_t framesSinceFullSearch_ = 0;
     AdapterStats counters_;
 };
 
@@ -154,14 +185,27 @@ class CoreBroadphase final : public BroadphaseAdapter {
 
     void calculateOverlappingPairs(btDispatcher* dispatcher) override {
         std::size_t candidates = 0;
+        const bool incremental = incrementalSearch();
         beginPairs();
-        core_.findCandidates([&](ObjectId a, ObjectId b) {
-            ++candidates;
-            if (overlaps(boxOf(a), boxOf(b))) {
-                markOverlap(a, b);
-            }
-        });
-        finishPairs(dispatcher, candidates);
+        if (incremental) {
+            forEachMoved([&](ObjectId moved) {
+                const Box& box = boxOf(moved);
+                core_.queryBox(box, [&](ObjectId id) {
+                    ++candidates;
+                    if (id != moved && overlaps(boxOf(id), box)) {
+                        markOverlap(moved, id);
+                    }
+                });
+            });
+        } else {
+            core_.findCandidates([&](ObjectId a, ObjectId b) {
+                ++candidates;
+                if (overlaps(boxOf(a), boxOf(b))) {
+                    markOverlap(a, b);
+                }
+            });
+        }
+        finishPairs(dispatcher, candidates, incremental);
     }
 
     void aabbTest(const btVector3& aabbMin, const btVector3& aabbMax,

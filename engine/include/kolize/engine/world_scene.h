@@ -9,12 +9,14 @@
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <utility>
 #include <vector>
 
 class btCollisionShape;
+class btStridingMeshInterface;
 class btRigidBody;
 class btCollisionDispatcher;
 class btDefaultCollisionConfiguration;
@@ -62,6 +64,10 @@ class WorldScene : public Scene {
     std::vector<btVector3> positions() const override;
     int movingObjects() const override { return dynamicBodies_; }
 
+    /// A 64-bit FNV-1a hash of the bytes of every dynamic body's transform and velocities:
+    /// equal hashes of two runs mean (up to hash collisions) bit-identical states.
+    std::uint64_t stateHash() const;
+
     btCollisionDispatcher& dispatcher() { return *dispatcher_; }
     const std::vector<btRigidBody*>& bodies() const { return bodies_; }
     const SceneOptions& options() const { return options_; }
@@ -70,6 +76,9 @@ class WorldScene : public Scene {
     // --- for builders ---
     /// Takes ownership of a shape; returns it.
     btCollisionShape* own(btCollisionShape* shape);
+    /// Takes ownership of a triangle mesh (kept until after every shape is deleted, for the
+    /// btBvhTriangleMeshShape that refers to it); returns it.
+    btStridingMeshInterface* ownMesh(btStridingMeshInterface* mesh);
     /// Adds a rigid body (mass 0: static) at `transform` shifted by origin(). Dynamic bodies
     /// get Bullet's CCD when it is on (SceneOptions::bulletCcd, or the scene's
     /// SceneNeeds::continuous by default): motion threshold and swept-sphere radius from the
@@ -95,6 +104,7 @@ class WorldScene : public Scene {
     std::unique_ptr<btBroadphaseInterface> broadphase_;
     std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
     std::unique_ptr<TimedDynamicsWorld> world_;
+    std::vector<std::unique_ptr<btStridingMeshInterface>> meshes_;  // before shapes_: outlives them
     std::vector<std::unique_ptr<btCollisionShape>> shapes_;
     std::vector<btRigidBody*> bodies_;
     int dynamicBodies_ = 0;
