@@ -136,47 +136,25 @@ const std::vector<SceneEntry>& sceneEntries() {
         auto add = [&](SceneInfo info, SceneBuilder builder) {
             list.push_back({std::move(info), builder});
         };
-        SceneInfo info;
-        info = {"thesis-A",
-                "the thesis's scene A: 1000 turning cubes (edge 2) spread uniformly "
-                "over -500..500, slow or fast (--motion)",
-                "thesis",
-                1000,
-                streamNeeds(),
-                kStreamWhy,
-                0,
-                500 * 1.01};
-        add(info, buildThesis);
-        info = {"thesis-B",
-                "the thesis's scene B: 95% of 1000 turning cubes in a cluster of "
-                "edge 80, the rest uniform over -500..500, slow or fast (--motion)",
-                "thesis",
-                1000,
-                streamNeeds(),
-                kStreamWhy,
-                0,
-                500 * 1.01};
-        add(info, buildThesis);
-        info = {"boxes",
-                "Bullet's benchmark: 3000 unit boxes (layers of 8 x 8) falling onto a "
-                "static ground box",
-                "bullet",
-                3008,
-                SceneNeeds{},
-                kBoxesWhy,
-                0,
-                1000};
-        add(info, buildBoxes);
-        info = {"boxes-plane",
-                "the same 3000 boxes falling onto a static plane (its AABB is "
-                "+-1e18)",
-                "bullet",
-                3008,
-                SceneNeeds{},
-                kBoxesWhy,
-                0,
-                1000};
-        add(info, buildBoxes);
+        // The thesis's scenes live in -500..500; the boxes start within a few metres.
+        auto thesis = [&](const char* name, const char* summary) {
+            add({name, summary, "thesis", 1000, streamNeeds(), kStreamWhy, 0, 500 * 1.01},
+                buildThesis);
+        };
+        auto boxes = [&](const char* name, const char* summary) {
+            add({name, summary, "bullet", 3008, SceneNeeds{}, kBoxesWhy, 0, 1000}, buildBoxes);
+        };
+        thesis("thesis-A",
+               "the thesis's scene A: 1000 turning cubes (edge 2) spread uniformly over "
+               "-500..500, slow or fast (--motion)");
+        thesis("thesis-B",
+               "the thesis's scene B: 95% of 1000 turning cubes in a cluster of edge 80, the "
+               "rest uniform over -500..500, slow or fast (--motion)");
+        boxes("boxes",
+              "Bullet's benchmark: 3000 unit boxes (layers of 8 x 8) falling onto a static "
+              "ground box");
+        boxes("boxes-plane",
+              "the same 3000 boxes falling onto a static plane (its AABB is +-1e18)");
         addWorldScenes(list);
         return list;
     }();
