@@ -550,7 +550,9 @@ void lowerBoundSection(Context& context) {
 void box2dSection(Context& context) {
     context.heading("2D: kolize's cores against Box2D's dynamic tree");
     const std::vector<int> ns =
-        context.quick ? std::vector<int>{1000, 3000} : std::vector<int>{1000, 3000, 10000, 100000};
+        // Not 100 000: 2D scene B then packs 95 000 squares into an 80 x 80 cluster,
+        // 19 million true pairs, seconds per frame for every broadphase.
+        context.quick ? std::vector<int>{1000, 3000} : std::vector<int>{1000, 3000, 10000};
     Csv csv;
     if (!context.measure("bench2d", context.bench2d,
                          {"--n", csvList(ns), "--frames", context.quick ? "5" : "60"}, csv)) {
