@@ -9,6 +9,7 @@
 #include <kolize/engine/pair_stream.h>
 #include <kolize/engine/scene.h>
 #include <kolize/engine/statistics.h>
+#include <kolize/engine/store_only.h>
 #include <kolize/engine/world_scene.h>
 #include <kolize/kolize.h>
 
@@ -328,20 +329,6 @@ void progress(const std::string& what, int done, int total) {
 
 // --- running a scene ---
 
-/// Why a broadphase cannot take a scene of `objects` proxies, or empty.
-std::string skipReason(const std::string& name, int objects) {
-    if ((name == "brute-force" || name == "simple") && objects > 20000) {
-        return "O(N^2) per frame above 20000 objects";
-    }
-    if ((name == "sap" || name == "sap-noray") && objects > 32000) {
-        return "btAxisSweep3 holds at most 32766 proxies";
-    }
-    if (name == "sap32" && objects > 50000) {
-        return "bt32BitAxisSweep3's createProxy is O(N): minutes of init";
-    }
-    return {};
-}
-
 struct RunResult {
     Record record;
     std::vector<btVector3> finalPositions;
@@ -389,7 +376,8 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
     const bool ccd =
         sceneOptions.bulletCcd < 0 ? info.needs.continuous : sceneOptions.bulletCcd > 0;
     r.text("bullet_ccd", !info.needs.dynamics ? "" : ccd ? "on" : "off");
-    const std::string skipped = skipReason(name, objects);
+    // Room for the scene's static bodies too (broadphaseSettingsFor gives 64).
+    const std::string skipped = kolize::measurementSkipReason(name, objects + 64);
     if (!skipped.empty()) {
         r.text("status", "skipped: " + skipped);
         return result;

@@ -273,17 +273,8 @@ Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, in
     Row row;
     row.label = entry.label;
     const int n = sceneSettings.objects;
-    if ((entry.name == "brute-force" || entry.name == "simple") && n > 20000) {
-        row.skipped = "O(N^2)";
-        return row;
-    }
-    if ((entry.name == "sap" || entry.name == "sap-noray") && n > 32766) {
-        row.skipped = "max 32766 proxies";
-        return row;
-    }
-    if (entry.name == "sap32" && n > 50000) {
-        // Measured: 1.1 s of createProxy at N = 10000, over 10 minutes at N = 100000.
-        row.skipped = "O(N) per createProxy, O(N^2) init";
+    row.skipped = kolize::measurementSkipReason(entry.name, n);
+    if (!row.skipped.empty()) {
         return row;
     }
     kolize::ThesisScene<3> scene(sceneSettings);

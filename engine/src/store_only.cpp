@@ -125,6 +125,19 @@ bool isStoreOnly(std::string_view name) {
     return name == "store-only";
 }
 
+std::string measurementSkipReason(std::string_view name, int proxies) {
+    if ((name == "brute-force" || name == "simple") && proxies > 20000) {
+        return "O(N^2) per frame above 20000 objects";
+    }
+    if ((name == "sap" || name == "sap-noray") && proxies > 32766) {
+        return "btAxisSweep3 holds at most 32766 proxies";
+    }
+    if (name == "sap32" && proxies > 50000) {
+        return "bt32BitAxisSweep3's createProxy is O(N): minutes of init";
+    }
+    return {};
+}
+
 std::unique_ptr<btBroadphaseInterface> makeMeasuredBroadphase(std::string_view name,
                                                               const BroadphaseSettings& settings) {
     if (isStoreOnly(name)) {

@@ -11,6 +11,7 @@
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 
 #include <memory>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -77,6 +78,12 @@ class StoreOnlyBroadphase : public btBroadphaseInterface {
 /// makeBroadphase accepts. Throws std::invalid_argument for an unknown name.
 std::unique_ptr<btBroadphaseInterface> makeMeasuredBroadphase(std::string_view name,
                                                               const BroadphaseSettings& settings);
+
+/// Why a benchmark skips broadphase `name` with `proxies` proxies, or empty when it runs:
+/// brute-force and simple above 20000 (O(N^2) per frame), sap and sap-noray above 32766
+/// (btAxisSweep3's 16-bit handles), sap32 above 50000 (O(N) per createProxy: 1.1 s of init
+/// at 10000, over 10 minutes at 100000).
+std::string measurementSkipReason(std::string_view name, int proxies);
 
 /// True for "store-only".
 bool isStoreOnly(std::string_view name);
