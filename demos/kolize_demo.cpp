@@ -49,6 +49,8 @@ const char* kUsage =
     "                            scenes with fast objects)\n"
     "  --reference-substeps K    also run each scene with K times the substeps and report\n"
     "                            the bodies' drift from it at the last frame\n"
+    "  --fat-margin F            kolize broadphases: fat-box margin, a fraction of each\n"
+    "                            box's extent (default 0.05; 0 turns fat boxes off)\n"
     "  --replay-check            record an untimed run of the first broadphase and replay\n"
     "                            that one stream into every broadphase (identical input)\n"
     "  --determinism             Bullet's deterministic pair order on; compare every body\n"
@@ -73,6 +75,7 @@ struct Options {
     kolize::SceneOptions scene;
     int frames = 200;
     int referenceSubsteps = 0;
+    double fatMargin = -1;  ///< < 0: the broadphases' default
     bool replayCheck = false;
     bool determinism = false;
     std::string record, replay, csv, json;
@@ -198,6 +201,13 @@ Options parse(int argc, char** argv) {
             options.scene.bulletCcd = value == "auto" ? -1 : value == "on" ? 1 : 0;
         } else if (flag == "--reference-substeps") {
             options.referenceSubsteps = int(wholeNumber(flag, value, 2, 1000));
+        } else if (flag == "--fat-margin") {
+            char* end = nullptr;
+            options.fatMargin = std::strtod(value.c_str(), &end);
+            if (value.empty() || *end != '\0' || !(options.fatMargin >= 0) ||
+                !(options.fatMargin <= 10)) {
+                fail("--fat-margin needs a number in 0..10, got '" + value + "'");
+            }
         } else if (flag == "--record") {
             options.record = value;
         } else if (flag == "--replay") {
@@ -356,6 +366,16 @@ void printPipeline(const kolize::SceneInfo& info, const kolize::SceneOptions& op
                     : "");
 }
 
+kolize::BroadphaseSettings settingsFor(const kolize::SceneInfo& info,
+                                       const kolize::SceneOptions& sceneOptions,
+                                       const Options& options) {
+    kolize::BroadphaseSettings settings = kolize::broadphaseSettingsFor(info, sceneOptions);
+    if (options.fatMargin >= 0) {
+        settings.fatMargin = btScalar(options.fatMargin);
+    }
+    return settings;
+}
+
 RunResult runScene(const std::string& sceneName, const std::string& name,
                    const kolize::SceneOptions& sceneOptions, const Options& options,
                    kolize::PairStream* record, bool hashes) {
@@ -383,8 +403,7 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
         return result;
     }
     try {
-        const kolize::BroadphaseSettings settings =
-            kolize::broadphaseSettingsFor(info, sceneOptions);
+        const kolize::BroadphaseSettings settings = settingsFor(info, sceneOptions, options);
         std::unique_ptr<btBroadphaseInterface> inner = kolize::makeBroadphase(name, settings);
         std::unique_ptr<btBroadphaseInterface> broadphase;
         if (record != nullptr) {
@@ -643,8 +662,11 @@ int replayFile(const Options& options) {
     } catch (const std::exception& error) {
         fail(error.what());
     }
-    const std::vector<Record> rows =
-        replayRecords(stream, options, options.replay, kolize::BroadphaseSettings{});
+    kolize::BroadphaseSettings settings;
+    if (options.fatMargin >= 0) {
+        settings.fatMargin = btScalar(options.fatMargin);
+    }
+    const std::vector<Record> rows = replayRecords(stream, options, options.replay, settings);
     kolize::SceneNeeds needs;
     needs.dynamics = false;
     printTable("replay of " + options.replay + " (" + std::to_string(stream.frames()) +
@@ -744,7 +766,7 @@ int main(int argc, char** argv) {
         all.insert(all.end(), rows.begin(), rows.end());
         if (options.replayCheck && !stream.events.empty()) {
             const std::vector<Record> replayed = replayRecords(
-                stream, options, sceneName, kolize::broadphaseSettingsFor(info, options.scene));
+                stream, options, sceneName, settingsFor(info, options.scene, options));
             kolize::SceneNeeds streamNeeds;
             streamNeeds.dynamics = false;
             printTable("scene " + sceneName + ", replay of " + options.broadphases.front() +

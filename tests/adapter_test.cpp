@@ -179,6 +179,12 @@ TEST(Factory, MakesEveryNameAndRejectsBadSettings) {
     BroadphaseSettings withDeferred;
     withDeferred.pairCache = &deferred;
     EXPECT_THROW(makeBroadphase("brute-force", withDeferred), std::invalid_argument);
+    for (btScalar margin :
+         {btScalar(-0.1), btScalar(11), std::numeric_limits<btScalar>::quiet_NaN()}) {
+        BroadphaseSettings badMargin;
+        badMargin.fatMargin = margin;
+        EXPECT_THROW(makeBroadphase("grid", badMargin), std::invalid_argument) << margin;
+    }
     EXPECT_TRUE(isExactBroadphase("brute-force"));
     EXPECT_FALSE(isExactBroadphase("dbvt"));
 }
@@ -418,6 +424,112 @@ TEST(IncrementalSearch, FewMovedBoxesGiveTheExactPairsLikeAFullSearch) {
         EXPECT_GT(pairsSeen, 150u * 20);
         EXPECT_GT(adapter->stats().incrementalSearches, 100u);
         EXPECT_LT(adapter->stats().incrementalSearches, 140u);
+    }
+}
+
+// Fat boxes: slow objects get enlarged core boxes and jitter inside them without a core
+// update. A pile that jitters, a few boxes that slide slowly out of their fat boxes, a few
+// that jump, and filter changes: the pair cache and the box and ray queries must stay exact
+// every frame, for every margin (0 is off) and every exact broadphase.
+TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
+    for (const btScalar margin : {btScalar(0), btScalar(0.05), btScalar(0.5)}) {
+        for (const std::string& name : broadphaseNames()) {
+            if (!isExactBroadphase(name)) {
+                continue;
+            }
+            SCOPED_TRACE(name + ", fatMargin " + std::to_string(margin));
+            BroadphaseSettings settings;
+            settings.fatMargin = margin;
+            auto broadphase = makeBroadphase(name, settings);
+            std::mt19937 random(11);
+            std::uniform_real_distribution<double> unit(0, 1);
+            // A 10x10x4 lattice of touching unit boxes: the jitter makes neighbours overlap
+            // in some frames and not in others; with a margin every neighbour is a candidate.
+            std::vector<btBroadphaseProxy*> proxies;
+            std::map<const btBroadphaseProxy*, ProxyBox> boxes;
+            static char client;
+            for (int i = 0; i < 400; ++i) {
+                const btVector3 lo(btScalar(i % 10), btScalar(i / 10 % 10), btScalar(i / 100));
+                ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
+                box.proxy =
+                    broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+                proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+                boxes[box.proxy] = box;
+            }
+            std::size_t overlapsSeen = 0, queryHits = 0;
+            for (int frame = 0; frame < 120; ++frame) {
+                for (std::size_t i = 0; i < proxies.size(); ++i) {
+                    ProxyBox& box = boxes[proxies[i]];
+                    btVector3 step(0, 0, 0);
+                    if (i % 40 == 7 || i % 40 == 17) {
+                        // Slides, slow or faster: leaves its fat box now and then.
+                        step.setX(btScalar(i % 40 == 7 ? 0.004 : 0.03));
+                    } else if (i % 97 == 3 && frame % 30 == 29) {
+                        step.setY(btScalar(3 * unit(random) - 1.5));  // jumps
+                    } else {
+                        for (int axis = 0; axis < 3; ++axis) {  // resting jitter
+                            step[axis] = btScalar(0.0004 * (unit(random) - 0.5));
+                        }
+                    }
+                    box.aabbMin += step;
+                    box.aabbMax += step;
+                    broadphase->setAabb(proxies[i], box.aabbMin, box.aabbMax, nullptr);
+                }
+                if (frame % 17 == 8) {  // a jittering proxy stops colliding with group 1
+                    proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
+                }
+                broadphase->calculateOverlappingPairs(nullptr);
+                std::vector<ProxyBox> live;
+                for (const auto& entry : boxes) {
+                    live.push_back(entry.second);
+                }
+                const btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();
+                const std::vector<UidPair> truth = exactPairs(live, cache);
+                ASSERT_EQ(cachedPairs(*cache), truth) << "frame " << frame;
+                overlapsSeen += truth.size();
+
+                // An aabbTest around a jittering box finds exactly the boxes overlapping it.
+                const ProxyBox& probe = boxes[proxies[std::size_t(frame) * 37 % proxies.size()]];
+                struct Collect : btBroadphaseAabbCallback {
+                    std::vector<int> uids;
+                    bool process(const btBroadphaseProxy* proxy) override {
+                        uids.push_back(proxy->m_uniqueId);
+                        return true;
+                    }
+                } found;
+                broadphase->aabbTest(probe.aabbMin, probe.aabbMax, found);
+                std::vector<int> expected;
+                for (const ProxyBox& other : live) {
+                    if (TestAabbAgainstAabb2(probe.aabbMin, probe.aabbMax, other.aabbMin,
+                                             other.aabbMax)) {
+                        expected.push_back(other.proxy->m_uniqueId);
+                    }
+                }
+                std::sort(found.uids.begin(), found.uids.end());
+                std::sort(expected.begin(), expected.end());
+                ASSERT_EQ(found.uids, expected) << "frame " << frame;
+                queryHits += expected.size();
+            }
+            auto* adapter = dynamic_cast<BroadphaseAdapter*>(broadphase.get());
+            ASSERT_NE(adapter, nullptr);
+            adapter->validate();
+            const AdapterStats stats = adapter->stats();
+            // Meaningful: the lattice's neighbours overlap now and then, and queries hit.
+            EXPECT_GT(overlapsSeen, 120u * 50);
+            EXPECT_GT(queryHits, 120u);
+            if (margin == 0) {
+                EXPECT_EQ(stats.movesInsideFatBoxes, 0u);
+                EXPECT_EQ(stats.candidatePairs, stats.overlappingPairs);
+            } else {
+                // Most jitter stays inside the fat boxes, the slides leave them, and most
+                // frames search only the few boxes whose core box changed.
+                EXPECT_GT(stats.movesInsideFatBoxes, 120u * 300);
+                EXPECT_GT(stats.coreUpdates, 400u + 30u);
+                EXPECT_LT(stats.coreUpdates, 120u * 400 / 10);
+                EXPECT_GT(stats.incrementalSearches, 100u);
+                EXPECT_GT(stats.candidatePairs, stats.overlappingPairs);
+            }
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -37,6 +38,12 @@ std::string BadAabbReport::message() const {
 
 BroadphaseAdapter::BroadphaseAdapter(std::string name, const BroadphaseSettings& settings)
     : name_(std::move(name)), settings_(settings) {
+    if (!(settings.fatMargin >= 0 && settings.fatMargin <= 10)) {
+        throw std::invalid_argument("kolize " + name_ +
+                                    ": settings.fatMargin must be in [0, 10] (a fraction of each "
+                                    "box's largest extent; 0 turns fat boxes off), got " +
+                                    std::to_string(settings.fatMargin));
+    }
     if (settings.pairCache != nullptr) {
         if (settings.pairCache->hasDeferredRemoval()) {
             throw std::invalid_argument(
@@ -127,6 +134,7 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
             chunks_.emplace_back(new Proxy[std::size_t(1) << kChunkBits]);
         }
         boxes_.emplace_back();
+        fat_.emplace_back();
         state_.push_back(SlotState::Free);
         movedFlag_.push_back(0);
     }
@@ -149,7 +157,8 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
     }
     state_[slot] = SlotState::Live;
     boxes_[slot] = toBox(aabbMin, aabbMax);
-    coreInsert(slot, boxes_[slot]);
+    fat_[slot] = boxes_[slot];
+    coreInsert(slot, fat_[slot]);
     noteMoved(slot);
     return proxy;
 }
@@ -213,18 +222,58 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
     if (state_[slot] == SlotState::Live && box == boxes_[slot]) {
         return;  // unchanged (resting and sleeping bodies): nothing to do
     }
-    ours->m_aabbMin = aabbMin;
-    ours->m_aabbMax = aabbMax;
-    boxes_[slot] = box;
-    noteMoved(slot);
     if (state_[slot] == SlotState::Live) {
-        coreUpdate(slot, boxes_[slot]);
+        ours->m_aabbMin = aabbMin;
+        ours->m_aabbMax = aabbMax;
+        if (contains(fat_[slot], box)) {
+            boxes_[slot] = box;  // the core box still holds it: only the exact tests change
+            ++counters_.movesInsideFatBoxes;
+            return;
+        }
+        fat_[slot] = fatBox(box, boxes_[slot]);
+        boxes_[slot] = box;
+        coreUpdate(slot, fat_[slot]);
     } else {
         checkedProxy(proxy, "setAabb");
+        ours->m_aabbMin = aabbMin;
+        ours->m_aabbMax = aabbMax;
         state_[slot] = SlotState::Live;
         --parkedCount_;
-        coreInsert(slot, boxes_[slot]);
+        boxes_[slot] = box;
+        fat_[slot] = box;
+        coreInsert(slot, fat_[slot]);
     }
+    ++counters_.coreUpdates;
+    noteMoved(slot);
+}
+
+BroadphaseAdapter::Box BroadphaseAdapter::fatBox(const Box& box, const Box& previous) const {
+    if (settings_.fatMargin == 0) {
+        return box;
+    }
+    btScalar extent = 0, magnitude = 0, moved = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        extent = std::max(extent, box.hi[axis] - box.lo[axis]);
+        magnitude = std::max({magnitude, std::abs(box.lo[axis]), std::abs(box.hi[axis])});
+        moved = std::max({moved, std::abs(box.lo[axis] - previous.lo[axis]),
+                          std::abs(box.hi[axis] - previous.hi[axis])});
+    }
+    const btScalar margin =
+        settings_.fatMargin * extent + 2 * std::numeric_limits<btScalar>::epsilon() * magnitude;
+    if (!(4 * moved <= margin)) {
+        // Not slow: it would leave an enlarged box within a few frames, and meanwhile the
+        // box would add candidate pairs. Falling and flying objects keep exact boxes.
+        return box;
+    }
+    Box fat = box;
+    for (int axis = 0; axis < 3; ++axis) {
+        fat.lo[axis] -= margin;
+        fat.hi[axis] += margin;
+        if (!std::isfinite(fat.lo[axis]) || !std::isfinite(fat.hi[axis])) {
+            return box;  // near the float range's end: no room to enlarge
+        }
+    }
+    return fat;
 }
 
 void BroadphaseAdapter::getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin,
@@ -265,13 +314,14 @@ Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
 void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candidates,
                                     bool incremental) {
     const std::uint32_t stamp = stamp_;
+    std::size_t overlapping = 0;
     pairs_.retainIf([&](PairSet::Entry& entry) {
         Proxy* a = proxyOf(entry.first());
         Proxy* b = proxyOf(entry.second());
         if (entry.stamp != stamp && incremental && !movedFlag_[entry.first()] &&
             !movedFlag_[entry.second()] && state_[entry.first()] == SlotState::Live &&
             state_[entry.second()] == SlotState::Live) {
-            entry.stamp = stamp;  // neither box changed: the pair still overlaps
+            entry.stamp = stamp;  // neither core box changed: still a candidate
         }
         if (entry.stamp != stamp) {
             // Destroyed proxies already had their pairs removed by destroyProxy.
@@ -283,7 +333,9 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candid
             }
             return false;
         }
-        const bool wanted = pairCache_->needsBroadphaseCollision(a, b);
+        const bool overlap = overlaps(boxes_[entry.first()], boxes_[entry.second()]);
+        overlapping += overlap ? 1 : 0;
+        const bool wanted = overlap && pairCache_->needsBroadphaseCollision(a, b);
         if (wanted && !entry.inCache) {
             entry.inCache = pairCache_->addOverlappingPair(a, b) != nullptr;
             counters_.pairsAdded += entry.inCache ? 1 : 0;
@@ -303,6 +355,7 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candid
     counters_.incrementalSearches += incremental ? 1 : 0;
     ++counters_.frames;
     counters_.candidatesLastFrame = candidates;
+    counters_.overlappingPairs = overlapping;
 }
 
 void BroadphaseAdapter::resetPool(btDispatcher* /*dispatcher*/) {
@@ -311,6 +364,7 @@ void BroadphaseAdapter::resetPool(btDispatcher* /*dispatcher*/) {
     }
     chunks_.clear();
     boxes_.clear();
+    fat_.clear();
     state_.clear();
     freeSlots_.clear();
     pendingFree_.clear();
@@ -324,9 +378,9 @@ AdapterStats BroadphaseAdapter::stats() const {
     AdapterStats out = counters_;
     out.proxies = liveCount_;
     out.parkedProxies = parkedCount_;
-    out.overlappingPairs = pairs_.size();
+    out.candidatePairs = pairs_.size();
     out.memoryBytes = chunks_.size() * (sizeof(Proxy) << kChunkBits) +
-                      boxes_.capacity() * sizeof(Box) + state_.capacity() +
+                      (boxes_.capacity() + fat_.capacity()) * sizeof(Box) + state_.capacity() +
                       (freeSlots_.capacity() + pendingFree_.capacity()) * sizeof(ObjectId) +
                       pairs_.memoryBytes() + coreMemoryBytes();
     return out;
@@ -335,10 +389,12 @@ AdapterStats BroadphaseAdapter::stats() const {
 void BroadphaseAdapter::printStats() {
     const AdapterStats s = stats();
     std::printf(
-        "kolize %s: %zu proxies (%zu parked), %zu overlapping pairs, %zu frames, %zu candidates "
-        "last frame, %zu pairs added, %zu removed, %zu bad AABBs rejected, %zu bytes\n",
-        name_.c_str(), s.proxies, s.parkedProxies, s.overlappingPairs, s.frames,
-        s.candidatesLastFrame, s.pairsAdded, s.pairsRemoved, s.badAabbReports, s.memoryBytes);
+        "kolize %s: %zu proxies (%zu parked), %zu overlapping pairs (%zu candidate pairs), %zu "
+        "frames (%zu incremental), %zu candidates last frame, %zu core updates, %zu moves "
+        "inside fat boxes, %zu pairs added, %zu removed, %zu bad AABBs rejected, %zu bytes\n",
+        name_.c_str(), s.proxies, s.parkedProxies, s.overlappingPairs, s.candidatePairs, s.frames,
+        s.incrementalSearches, s.candidatesLastFrame, s.coreUpdates, s.movesInsideFatBoxes,
+        s.pairsAdded, s.pairsRemoved, s.badAabbReports, s.memoryBytes);
 }
 
 void BroadphaseAdapter::validate() const {
@@ -378,6 +434,11 @@ void BroadphaseAdapter::validate() const {
     }
     if (movedFlag_.size() != boxes_.size() || flagged != moved_.size()) {
         fail("moved list and flags disagree");
+    }
+    for (std::size_t slot = 0; slot < boxes_.size(); ++slot) {
+        if (state_[slot] == SlotState::Live && !contains(fat_[slot], boxes_[slot])) {
+            fail("core box of slot " + std::to_string(slot) + " does not contain its box");
+        }
     }
     pairs_.validate();
     pairs_.forEach([&](const PairSet::Entry& entry) {

@@ -37,6 +37,17 @@ inline bool overlaps(const Aabb<D, Scalar>& a, const Aabb<D, Scalar>& b) {
     return true;
 }
 
+/// True when `inner` lies inside the closed box `outer`.
+template <int D, class Scalar>
+inline bool contains(const Aabb<D, Scalar>& outer, const Aabb<D, Scalar>& inner) {
+    for (int axis = 0; axis < D; ++axis) {
+        if (inner.lo[axis] < outer.lo[axis] || inner.hi[axis] > outer.hi[axis]) {
+            return false;
+        }
+    }
+    return true;
+}
+
 /// True when every coordinate is finite and lo <= hi on every axis.
 template <int D, class Scalar>
 inline bool isValid(const Aabb<D, Scalar>& box) {

@@ -8,6 +8,11 @@
 /// core: candidates and queries come from it, the exact box test happens here, once per
 /// candidate.
 ///
+/// Fat boxes (BroadphaseSettings::fatMargin): the core holds, per object, a box that
+/// contains the exact one; slow objects get an enlarged box, so a setAabb inside it changes
+/// nothing in the core. The adapter keeps every pair whose core boxes overlap (the
+/// candidate pairs) from frame to frame and tests the exact boxes of each one every frame.
+///
 /// Exactness contract: after calculateOverlappingPairs the pair cache holds exactly the
 /// pairs whose current AABBs overlap (closed intervals) and that pass the cache's filters
 /// (evaluated every frame, so changed groups, masks or filter callbacks take effect on the
@@ -34,10 +39,14 @@ namespace kolize {
 struct AdapterStats {
     std::size_t proxies = 0;              ///< live proxies
     std::size_t parkedProxies = 0;        ///< live proxies without a valid box yet
-    std::size_t overlappingPairs = 0;     ///< pairs whose AABBs overlap (before filters)
+    std::size_t overlappingPairs = 0;     ///< pairs whose AABBs overlapped at the last search
+                                          ///< (before filters)
+    std::size_t candidatePairs = 0;       ///< pairs whose core (fat) boxes overlap
     std::size_t frames = 0;               ///< calculateOverlappingPairs calls
     std::size_t candidatesLastFrame = 0;  ///< candidate pairs the core produced last frame
     std::size_t incrementalSearches = 0;  ///< frames that queried only the moved objects
+    std::size_t movesInsideFatBoxes = 0;  ///< setAabb calls absorbed by a fat box, all time
+    std::size_t coreUpdates = 0;          ///< setAabb calls that changed a core box, all time
     std::size_t pairsAdded = 0;           ///< addOverlappingPair calls that added, all frames
     std::size_t pairsRemoved = 0;         ///< removeOverlappingPair calls, all frames
     std::size_t badAabbReports = 0;       ///< rejected boxes, all time
@@ -99,20 +108,21 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     static Ray<3, btScalar> toRay(const btVector3& rayFrom, const btBroadphaseRayCallback& callback,
                                   const btVector3& aabbMin, const btVector3& aabbMax);
 
+    /// The exact box (the last valid one Bullet gave).
     const Box& boxOf(ObjectId id) const { return boxes_[id]; }
+    /// The box the core holds: contains boxOf(id).
+    const Box& fatBoxOf(ObjectId id) const { return fat_[id]; }
     Proxy* proxyOf(ObjectId id) const { return &chunks_[id >> kChunkBits][id & kChunkMask]; }
 
-    /// Starts a frame of pair finding: call markOverlap for each overlapping pair once,
-    /// then finishPairs.
-    /// True when this pair search may be incremental: only the objects whose box changed
-    /// since the last search (at most a quarter of them) are queried, and the pairs between
-    /// unchanged objects are kept. A full search runs at least every kFullSearchEvery frames
-    /// (the cores re-tune themselves there).
+    /// True when this pair search may be incremental: only the objects whose core box
+    /// changed since the last search (at most a quarter of them) are queried, and the
+    /// candidate pairs between unchanged objects are kept. A full search runs at least every
+    /// kFullSearchEvery frames (the cores re-tune themselves there).
     bool incrementalSearch() const {
         return counters_.frames > 0 && framesSinceFullSearch_ < kFullSearchEvery &&
                moved_.size() * 4 <= liveCount_;
     }
-    /// Visits every live object whose box changed since the last pair search.
+    /// Visits every live object whose core box changed since the last pair search.
     template <class Visit>
     void forEachMoved(Visit&& visit) const {
         for (ObjectId id : moved_) {
@@ -121,14 +131,17 @@ class BroadphaseAdapter : public btBroadphaseInterface {
             }
         }
     }
+    /// Starts a frame of pair finding: call markCandidate for each pair whose core boxes
+    /// overlap (at least once), then finishPairs.
     void beginPairs() { ++stamp_; }
-    void markOverlap(ObjectId a, ObjectId b) {
+    void markCandidate(ObjectId a, ObjectId b) {
         bool inserted = false;
         pairs_.findOrInsert(a, b, inserted).stamp = stamp_;
     }
-    /// Applies the difference from the previous frame to the pair cache.
-    /// Applies the frame's pairs to the pair cache. After an incremental search the pairs
-    /// between two unmoved live objects are kept without being marked.
+    /// Tests the exact boxes of every candidate pair and applies the difference from the
+    /// previous frame to the pair cache. After an incremental search the candidate pairs
+    /// between two live objects whose core boxes did not change are kept without being
+    /// marked.
     void finishPairs(btDispatcher* dispatcher, std::size_t candidates, bool incremental);
 
   private:
@@ -143,6 +156,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     static const char* rejectReason(const btVector3& aabbMin, const btVector3& aabbMax);
     void reportBadAabb(const char* operation, const Proxy& proxy, const btVector3& aabbMin,
                        const btVector3& aabbMax, const char* reason);
+    /// The core box for `box`, which replaces `previous`: enlarged when the object moved
+    /// less than the margin, else `box` itself.
+    Box fatBox(const Box& box, const Box& previous) const;
 
     std::string name_;
     BroadphaseSettings settings_;
@@ -151,6 +167,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
 
     std::vector<std::unique_ptr<Proxy[]>> chunks_;
     std::vector<Box> boxes_;
+    std::vector<Box> fat_;
     std::vector<SlotState> state_;
     std::vector<ObjectId> freeSlots_;
     std::vector<ObjectId> pendingFree_;
@@ -189,19 +206,19 @@ class CoreBroadphase final : public BroadphaseAdapter {
         beginPairs();
         if (incremental) {
             forEachMoved([&](ObjectId moved) {
-                const Box& box = boxOf(moved);
+                const Box& box = fatBoxOf(moved);
                 core_.queryBox(box, [&](ObjectId id) {
                     ++candidates;
-                    if (id != moved && overlaps(boxOf(id), box)) {
-                        markOverlap(moved, id);
+                    if (id != moved && overlaps(fatBoxOf(id), box)) {
+                        markCandidate(moved, id);
                     }
                 });
             });
         } else {
             core_.findCandidates([&](ObjectId a, ObjectId b) {
                 ++candidates;
-                if (overlaps(boxOf(a), boxOf(b))) {
-                    markOverlap(a, b);
+                if (overlaps(fatBoxOf(a), fatBoxOf(b))) {
+                    markCandidate(a, b);
                 }
             });
         }

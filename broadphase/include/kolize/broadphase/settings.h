@@ -52,6 +52,16 @@ struct BroadphaseSettings {
     /// its first valid setAabb. Empty (the default): print the report's message() on stderr,
     /// the first 16 times per broadphase, then count silently (see printStats()).
     std::function<void(const BadAabbReport&)> onBadAabb;
+    /// Fat boxes for slow objects (kolize's own broadphases). The margin is this fraction of
+    /// the box's largest extent plus two float steps of its largest coordinate. An object
+    /// whose box moved less than a quarter of its margin since its last setAabb is stored in
+    /// the core with its box enlarged by the margin, as Box2D and dbvt keep boxes: while it
+    /// jitters inside (resting piles, stacks, slow sliding), setAabb changes nothing in the
+    /// core and the pair search skips it; only its candidate pairs get the exact box test.
+    /// Faster objects, and every object at creation, keep exact boxes (enlarged boxes would
+    /// only add candidates). The pairs reported are exact either way. 0 turns fat boxes off;
+    /// the factory accepts 0..10.
+    btScalar fatMargin = btScalar(0.05);
 
     /// Cell size, region and overflow rules of "grid", "spatial-tree" and "spatial-hash".
     CellGridSettings cells;
