@@ -350,6 +350,23 @@ TEST(PairStream, UnreadableFilesGiveErrorsNamingTheFileAndTheProblem) {
 namespace kolize {
 namespace {
 
+using BoxMap = std::map<const btBroadphaseProxy*, ProxyBox>;
+
+/// One frame's pair search: what the pair cache holds and the exact truth.
+struct FramePairs {
+    std::vector<UidPair> cached, truth;
+};
+
+FramePairs searchPairs(btBroadphaseInterface& broadphase, const BoxMap& boxes) {
+    broadphase.calculateOverlappingPairs(nullptr);
+    std::vector<ProxyBox> live;
+    for (const auto& entry : boxes) {
+        live.push_back(entry.second);
+    }
+    const btOverlappingPairCache* cache = broadphase.getOverlappingPairCache();
+    return {cachedPairs(*cache), exactPairs(live, cache)};
+}
+
 // Frames where few boxes move take the incremental search (query the moved boxes, keep the
 // pairs of unmoved ones); frames where many move take the full one. Both must give the exact
 // pairs, through creation, destruction, boxes set to the same value, and filter changes.
@@ -363,7 +380,7 @@ TEST(IncrementalSearch, FewMovedBoxesGiveTheExactPairsLikeAFullSearch) {
         std::mt19937 random(7);
         std::uniform_real_distribution<double> position(-20, 20), size(0.2, 3);
         std::vector<btBroadphaseProxy*> proxies;
-        std::map<const btBroadphaseProxy*, ProxyBox> boxes;
+        BoxMap boxes;
         static char client;
         auto randomBox = [&](ProxyBox& box) {
             const btVector3 lo(btScalar(position(random)), btScalar(position(random)),
@@ -407,15 +424,9 @@ TEST(IncrementalSearch, FewMovedBoxesGiveTheExactPairsLikeAFullSearch) {
             if (frame % 13 == 5) {  // an unmoved proxy stops colliding with group 1
                 proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
             }
-            broadphase->calculateOverlappingPairs(nullptr);
-            std::vector<ProxyBox> live;
-            for (const auto& entry : boxes) {
-                live.push_back(entry.second);
-            }
-            const btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();
-            const std::vector<UidPair> truth = exactPairs(live, cache);
-            ASSERT_EQ(cachedPairs(*cache), truth) << "frame " << frame;
-            pairsSeen += truth.size();
+            const FramePairs pairs = searchPairs(*broadphase, boxes);
+            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+            pairsSeen += pairs.truth.size();
         }
         auto* adapter = dynamic_cast<BroadphaseAdapter*>(broadphase.get());
         ASSERT_NE(adapter, nullptr);
@@ -446,7 +457,7 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
             // A 10x10x4 lattice of touching unit boxes: the jitter makes neighbours overlap
             // in some frames and not in others; with a margin every neighbour is a candidate.
             std::vector<btBroadphaseProxy*> proxies;
-            std::map<const btBroadphaseProxy*, ProxyBox> boxes;
+            BoxMap boxes;
             static char client;
             for (int i = 0; i < 400; ++i) {
                 const btVector3 lo(btScalar(i % 10), btScalar(i / 10 % 10), btScalar(i / 100));
@@ -478,15 +489,9 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
                 if (frame % 17 == 8) {  // a jittering proxy stops colliding with group 1
                     proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
                 }
-                broadphase->calculateOverlappingPairs(nullptr);
-                std::vector<ProxyBox> live;
-                for (const auto& entry : boxes) {
-                    live.push_back(entry.second);
-                }
-                const btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();
-                const std::vector<UidPair> truth = exactPairs(live, cache);
-                ASSERT_EQ(cachedPairs(*cache), truth) << "frame " << frame;
-                overlapsSeen += truth.size();
+                const FramePairs pairs = searchPairs(*broadphase, boxes);
+                ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+                overlapsSeen += pairs.truth.size();
 
                 // An aabbTest around a jittering box finds exactly the boxes overlapping it.
                 const ProxyBox& probe = boxes[proxies[std::size_t(frame) * 37 % proxies.size()]];
@@ -499,7 +504,8 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
                 } found;
                 broadphase->aabbTest(probe.aabbMin, probe.aabbMax, found);
                 std::vector<int> expected;
-                for (const ProxyBox& other : live) {
+                for (const auto& entry : boxes) {
+                    const ProxyBox& other = entry.second;
                     if (TestAabbAgainstAabb2(probe.aabbMin, probe.aabbMax, other.aabbMin,
                                              other.aabbMax)) {
                         expected.push_back(other.proxy->m_uniqueId);

@@ -532,7 +532,8 @@ void lowerBoundSection(Context& context) {
                         ? fmt(1e6 * benchValue(csv, scene, "slow", label, n, "frame_ms") / n) +
                               " ns/object"
                         : times(multiple));
-                if (n == ns.back() && label != "store-only" && !(multiple >= bestMultiple)) {
+                if (n == ns.back() && label != "store-only" && !std::isnan(multiple) &&
+                    !(multiple >= bestMultiple)) {
                     bestMultiple = multiple;
                     best = label;
                 }
