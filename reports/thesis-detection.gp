@@ -1,0 +1,179 @@
+set terminal pngcairo size 1200,500 noenhanced
+set output "thesis-detection.png"
+$sA0 << EOD
+250 0.009995
+500 0.020811
+750 0.033720
+1000 0.044456
+1250 0.043664
+1500 0.052839
+1750 0.090294
+2000 0.075983
+3000 0.115992
+EOD
+$sA1 << EOD
+250 0.014000
+500 0.028502
+750 0.042142
+1000 0.058687
+1250 0.059268
+1500 0.070685
+1750 0.107460
+2000 0.099438
+3000 0.162121
+EOD
+$sA2 << EOD
+250 0.012729
+500 0.024316
+750 0.035593
+1000 0.049083
+1250 0.051577
+1500 0.063044
+1750 0.073459
+2000 0.084286
+3000 0.162061
+EOD
+$sA3 << EOD
+250 0.013230
+500 0.026859
+750 0.039789
+1000 0.054661
+1250 0.057405
+1500 0.068502
+1750 0.093740
+2000 0.099828
+3000 0.150774
+EOD
+$sA4 << EOD
+250 0.055542
+500 0.130174
+750 0.242330
+1000 0.365113
+1250 0.431511
+1500 0.557539
+1750 0.686430
+2000 0.807520
+3000 1.323247
+EOD
+$sA5 << EOD
+250 0.058607
+500 0.130003
+750 0.216452
+1000 0.301748
+1250 0.338383
+1500 0.420865
+1750 0.510588
+2000 0.600863
+3000 1.005654
+EOD
+$sA6 << EOD
+250 0.001953
+500 0.003966
+750 0.005709
+1000 0.007111
+1250 0.008874
+1500 0.011697
+1750 0.012419
+2000 0.014161
+3000 0.021282
+EOD
+$sB0 << EOD
+250 0.025128
+500 0.137725
+750 0.310923
+1000 0.586522
+1250 1.033837
+1500 1.395043
+1750 2.200901
+2000 2.830707
+3000 4.722118
+EOD
+$sB1 << EOD
+250 0.012048
+500 0.028222
+750 0.046569
+1000 0.067290
+1250 0.096503
+1500 0.126418
+1750 0.227548
+2000 0.214990
+3000 0.559471
+EOD
+$sB2 << EOD
+250 0.010766
+500 0.023064
+750 0.039068
+1000 0.056835
+1250 0.078727
+1500 0.101470
+1750 0.129373
+2000 0.155290
+3000 0.331483
+EOD
+$sB3 << EOD
+250 0.012448
+500 0.026900
+750 0.045247
+1000 0.066349
+1250 0.089042
+1500 0.116103
+1750 0.137845
+2000 0.172827
+3000 0.315929
+EOD
+$sB4 << EOD
+250 0.110794
+500 0.243522
+750 0.419694
+1000 0.647272
+1250 0.813129
+1500 1.381664
+1750 1.518417
+2000 1.488242
+3000 3.021470
+EOD
+$sB5 << EOD
+250 0.076103
+500 0.154179
+750 0.258965
+1000 0.381166
+1250 0.500364
+1500 0.751907
+1750 0.837074
+2000 0.875731
+3000 1.769529
+EOD
+$sB6 << EOD
+250 0.001812
+500 0.003575
+750 0.005338
+1000 0.007110
+1250 0.008883
+1500 0.011688
+1750 0.014232
+2000 0.014181
+3000 0.021913
+EOD
+set multiplot layout 1,2 title "kolize-bench, thesis scenes, slow motion: detection time per frame"
+set logscale xy
+set grid
+set key top left
+set xlabel "N (objects)"
+set ylabel "ms per frame (median)"
+set title "scene A (uniform)"
+plot $sA0 using 1:2 with linespoints title "grid", \
+     $sA1 using 1:2 with linespoints title "spatial-tree", \
+     $sA2 using 1:2 with linespoints title "segment-trees", \
+     $sA3 using 1:2 with linespoints title "range-tree", \
+     $sA4 using 1:2 with linespoints title "dbvt", \
+     $sA5 using 1:2 with linespoints title "sap", \
+     $sA6 using 1:2 with linespoints title "store-only"
+set title "scene B (clustered)"
+plot $sB0 using 1:2 with linespoints title "grid", \
+     $sB1 using 1:2 with linespoints title "spatial-tree", \
+     $sB2 using 1:2 with linespoints title "segment-trees", \
+     $sB3 using 1:2 with linespoints title "range-tree", \
+     $sB4 using 1:2 with linespoints title "dbvt", \
+     $sB5 using 1:2 with linespoints title "sap", \
+     $sB6 using 1:2 with linespoints title "store-only"
+unset multiplot
