@@ -378,6 +378,7 @@ AdapterStats BroadphaseAdapter::stats() const {
     AdapterStats out = counters_;
     out.proxies = liveCount_;
     out.parkedProxies = parkedCount_;
+    out.slots = boxes_.size();
     out.candidatePairs = pairs_.size();
     out.memoryBytes = chunks_.size() * (sizeof(Proxy) << kChunkBits) +
                       (boxes_.capacity() + fat_.capacity()) * sizeof(Box) + state_.capacity() +

@@ -39,6 +39,7 @@ namespace kolize {
 struct AdapterStats {
     std::size_t proxies = 0;              ///< live proxies
     std::size_t parkedProxies = 0;        ///< live proxies without a valid box yet
+    std::size_t slots = 0;                ///< proxy slots allocated: live, free or awaiting reuse
     std::size_t overlappingPairs = 0;     ///< pairs whose AABBs overlapped at the last search
                                           ///< (before filters)
     std::size_t candidatePairs = 0;       ///< pairs whose core (fat) boxes overlap
