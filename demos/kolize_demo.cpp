@@ -366,14 +366,19 @@ void printPipeline(const kolize::SceneInfo& info, const kolize::SceneOptions& op
                     : "");
 }
 
-kolize::BroadphaseSettings settingsFor(const kolize::SceneInfo& info,
-                                       const kolize::SceneOptions& sceneOptions,
+/// `settings` with the command line's broadphase options applied.
+kolize::BroadphaseSettings withOptions(kolize::BroadphaseSettings settings,
                                        const Options& options) {
-    kolize::BroadphaseSettings settings = kolize::broadphaseSettingsFor(info, sceneOptions);
     if (options.fatMargin >= 0) {
         settings.fatMargin = btScalar(options.fatMargin);
     }
     return settings;
+}
+
+kolize::BroadphaseSettings settingsFor(const kolize::SceneInfo& info,
+                                       const kolize::SceneOptions& sceneOptions,
+                                       const Options& options) {
+    return withOptions(kolize::broadphaseSettingsFor(info, sceneOptions), options);
 }
 
 RunResult runScene(const std::string& sceneName, const std::string& name,
@@ -662,11 +667,8 @@ int replayFile(const Options& options) {
     } catch (const std::exception& error) {
         fail(error.what());
     }
-    kolize::BroadphaseSettings settings;
-    if (options.fatMargin >= 0) {
-        settings.fatMargin = btScalar(options.fatMargin);
-    }
-    const std::vector<Record> rows = replayRecords(stream, options, options.replay, settings);
+    const std::vector<Record> rows =
+        replayRecords(stream, options, options.replay, withOptions({}, options));
     kolize::SceneNeeds needs;
     needs.dynamics = false;
     printTable("replay of " + options.replay + " (" + std::to_string(stream.frames()) +
