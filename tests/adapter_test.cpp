@@ -143,17 +143,100 @@ TEST(ProxyLifetime, ChurnWithoutPairFindingReleasesSlotsAndKeepsPairsRight) {
     adapter.validate();
 }
 
-TEST(Filters, ChangedGroupsAndMasksTakeEffectOnTheNextFrame) {
-    auto broadphase = makeBroadphase("brute-force");
-    char clients[2];
-    btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
-                                                   &clients[0], 1, -1, nullptr);
-    broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[1], 2, -1, nullptr);
-    EXPECT_EQ(pairCount(*broadphase), 1);
-    a->m_collisionFilterMask = 1;  // no longer accepts group 2
-    EXPECT_EQ(pairCount(*broadphase), 0);
-    a->m_collisionFilterMask = -1;
-    EXPECT_EQ(pairCount(*broadphase), 1);
+// Bullet's contract (the default, FilterEvaluation::WhenAdded): filters are evaluated when a
+// pair starts overlapping; a change in place waits for the next overlap.
+TEST(Filters, InPlaceChangesTakeEffectWhenThePairNextStartsOverlapping) {
+    for (const std::string& name : broadphaseNames()) {
+        if (!isExactBroadphase(name)) {
+            continue;
+        }
+        SCOPED_TRACE(name);
+        auto broadphase = makeBroadphase(name);
+        char clients[2];
+        btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
+                                                       &clients[0], 1, -1, nullptr);
+        broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[1], 2, -1,
+                                nullptr);
+        EXPECT_EQ(pairCount(*broadphase), 1);
+        a->m_collisionFilterMask = 1;  // no longer accepts group 2
+        EXPECT_EQ(pairCount(*broadphase), 1) << "the overlapping pair keeps its verdict";
+        broadphase->setAabb(a, btVector3(5, 5, 5), btVector3(6, 6, 6), nullptr);
+        EXPECT_EQ(pairCount(*broadphase), 0);
+        broadphase->setAabb(a, btVector3(0.5, 0.5, 0.5), btVector3(1.5, 1.5, 1.5), nullptr);
+        EXPECT_EQ(pairCount(*broadphase), 0) << "a new overlap sees the new mask";
+        a->m_collisionFilterMask = -1;
+        EXPECT_EQ(pairCount(*broadphase), 0) << "the rejected pair keeps its verdict";
+        dynamic_cast<BroadphaseAdapter&>(*broadphase).validate();
+    }
+}
+
+// The ways Bullet users change filters: remove and add the object again with new groups, or
+// refreshBroadphaseProxy after changing them. Either takes effect at the next step.
+TEST(Filters, ReAddedOrRefreshedObjectsGetTheirNewFiltersAtOnce) {
+    for (const std::string& name : broadphaseNames()) {
+        if (!isExactBroadphase(name)) {
+            continue;
+        }
+        SCOPED_TRACE(name);
+        auto broadphase = makeBroadphase(name);
+        btDefaultCollisionConfiguration configuration;
+        btCollisionDispatcher dispatcher(&configuration);
+        btCollisionWorld world(&dispatcher, broadphase.get(), &configuration);
+        btBoxShape shape(btVector3(1, 1, 1));
+        btCollisionObject objects[3];
+        for (int i = 0; i < 3; ++i) {
+            objects[i].setCollisionShape(&shape);
+            objects[i].getWorldTransform().setOrigin(btVector3(btScalar(i), 0, 0));
+            world.addCollisionObject(&objects[i], 1, -1);
+        }
+        auto pairs = [&] {
+            world.performDiscreteCollisionDetection();
+            return broadphase->getOverlappingPairCache()->getNumOverlappingPairs();
+        };
+        EXPECT_EQ(pairs(), 3);
+        // Removed and added again with a mask that rejects group 1.
+        world.removeCollisionObject(&objects[0]);
+        world.addCollisionObject(&objects[0], 2, 2);
+        EXPECT_EQ(pairs(), 1);
+        // Changed in place, then refreshed.
+        objects[1].getBroadphaseHandle()->m_collisionFilterMask = 0;
+        EXPECT_EQ(pairs(), 1) << "in place only: the pair keeps its verdict";
+        world.refreshBroadphaseProxy(&objects[1]);
+        EXPECT_EQ(pairs(), 0);
+        objects[1].getBroadphaseHandle()->m_collisionFilterMask = -1;
+        objects[0].getBroadphaseHandle()->m_collisionFilterMask = -1;
+        world.refreshBroadphaseProxy(&objects[0]);
+        world.refreshBroadphaseProxy(&objects[1]);
+        EXPECT_EQ(pairs(), 3);
+        dynamic_cast<BroadphaseAdapter&>(*broadphase).validate();
+        for (btCollisionObject& object : objects) {
+            world.removeCollisionObject(&object);
+        }
+    }
+}
+
+// FilterEvaluation::EveryFrame: changes in place take effect at the next pair search.
+TEST(Filters, EveryFrameSettingTakesInPlaceChangesAtTheNextSearch) {
+    for (const std::string& name : broadphaseNames()) {
+        if (!isExactBroadphase(name)) {
+            continue;
+        }
+        SCOPED_TRACE(name);
+        BroadphaseSettings settings;
+        settings.filters = FilterEvaluation::EveryFrame;
+        auto broadphase = makeBroadphase(name, settings);
+        char clients[2];
+        btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
+                                                       &clients[0], 1, -1, nullptr);
+        broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0, &clients[1], 2, -1,
+                                nullptr);
+        EXPECT_EQ(pairCount(*broadphase), 1);
+        a->m_collisionFilterMask = 1;  // no longer accepts group 2
+        EXPECT_EQ(pairCount(*broadphase), 0);
+        a->m_collisionFilterMask = -1;
+        EXPECT_EQ(pairCount(*broadphase), 1);
+        dynamic_cast<BroadphaseAdapter&>(*broadphase).validate();
+    }
 }
 
 TEST(Factory, UnknownNameListsTheValidOnes) {
@@ -358,85 +441,96 @@ struct FramePairs {
     std::vector<UidPair> cached, truth;
 };
 
-FramePairs searchPairs(btBroadphaseInterface& broadphase, const BoxMap& boxes) {
+/// `admitted` models the filter contract of FilterEvaluation::WhenAdded; null for
+/// EveryFrame (the filters of now decide).
+FramePairs searchPairs(btBroadphaseInterface& broadphase, const BoxMap& boxes,
+                       AdmittedPairs* admitted) {
     broadphase.calculateOverlappingPairs(nullptr);
     std::vector<ProxyBox> live;
     for (const auto& entry : boxes) {
         live.push_back(entry.second);
     }
     const btOverlappingPairCache* cache = broadphase.getOverlappingPairCache();
-    return {cachedPairs(*cache), exactPairs(live, cache)};
+    return {cachedPairs(*cache),
+            admitted != nullptr ? admitted->update(live, cache) : exactPairs(live, cache)};
 }
 
 // Frames where few boxes move take the incremental search (query the moved boxes, keep the
 // pairs of unmoved ones); frames where many move take the full one. Both must give the exact
 // pairs, through creation, destruction, boxes set to the same value, and filter changes.
 TEST(IncrementalSearch, FewMovedBoxesGiveTheExactPairsLikeAFullSearch) {
-    for (const std::string& name : broadphaseNames()) {
-        if (!isExactBroadphase(name)) {
-            continue;
-        }
-        SCOPED_TRACE(name);
-        auto broadphase = makeBroadphase(name);
-        std::mt19937 random(7);
-        std::uniform_real_distribution<double> position(-20, 20), size(0.2, 3);
-        std::vector<btBroadphaseProxy*> proxies;
-        BoxMap boxes;
-        static char client;
-        auto randomBox = [&](ProxyBox& box) {
-            const btVector3 lo(btScalar(position(random)), btScalar(position(random)),
-                               btScalar(position(random)));
-            box.aabbMin = lo;
-            box.aabbMax = lo + btVector3(btScalar(size(random)), btScalar(size(random)),
-                                         btScalar(size(random)));
-        };
-        auto create = [&] {
-            ProxyBox box;
-            randomBox(box);
-            box.proxy =
-                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
-            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
-            boxes[box.proxy] = box;
-        };
-        for (int i = 0; i < 600; ++i) {
-            create();
-        }
-        std::size_t pairsSeen = 0;
-        for (int frame = 0; frame < 150; ++frame) {
-            // Mostly a few movers; every 10th frame most of them move.
-            const int movers = frame % 10 == 9 ? 500 : int(random() % 20);
-            for (int i = 0; i < movers; ++i) {
-                btBroadphaseProxy* proxy = proxies[random() % proxies.size()];
-                ProxyBox& box = boxes[proxy];
-                if (random() % 4 == 0) {  // the same box again: not a move
-                    broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
-                    continue;
-                }
-                randomBox(box);
-                broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+    for (const FilterEvaluation filters :
+         {FilterEvaluation::WhenAdded, FilterEvaluation::EveryFrame})
+        for (const std::string& name : broadphaseNames()) {
+            if (!isExactBroadphase(name)) {
+                continue;
             }
-            if (frame % 7 == 3) {
-                const std::size_t at = random() % proxies.size();
-                boxes.erase(proxies[at]);
-                broadphase->destroyProxy(proxies[at], nullptr);
-                proxies.erase(proxies.begin() + long(at));
+            SCOPED_TRACE(name + (filters == FilterEvaluation::EveryFrame ? ", every frame" : ""));
+            BroadphaseSettings settings;
+            settings.filters = filters;
+            auto broadphase = makeBroadphase(name, settings);
+            AdmittedPairs admitted;
+            std::mt19937 random(7);
+            std::uniform_real_distribution<double> position(-20, 20), size(0.2, 3);
+            std::vector<btBroadphaseProxy*> proxies;
+            BoxMap boxes;
+            static char client;
+            auto randomBox = [&](ProxyBox& box) {
+                const btVector3 lo(btScalar(position(random)), btScalar(position(random)),
+                                   btScalar(position(random)));
+                box.aabbMin = lo;
+                box.aabbMax = lo + btVector3(btScalar(size(random)), btScalar(size(random)),
+                                             btScalar(size(random)));
+            };
+            auto create = [&] {
+                ProxyBox box;
+                randomBox(box);
+                box.proxy =
+                    broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+                proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+                boxes[box.proxy] = box;
+            };
+            for (int i = 0; i < 600; ++i) {
                 create();
             }
-            if (frame % 13 == 5) {  // an unmoved proxy stops colliding with group 1
-                proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
+            std::size_t pairsSeen = 0;
+            for (int frame = 0; frame < 150; ++frame) {
+                // Mostly a few movers; every 10th frame most of them move.
+                const int movers = frame % 10 == 9 ? 500 : int(random() % 20);
+                for (int i = 0; i < movers; ++i) {
+                    btBroadphaseProxy* proxy = proxies[random() % proxies.size()];
+                    ProxyBox& box = boxes[proxy];
+                    if (random() % 4 == 0) {  // the same box again: not a move
+                        broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+                        continue;
+                    }
+                    randomBox(box);
+                    broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+                }
+                if (frame % 7 == 3) {
+                    const std::size_t at = random() % proxies.size();
+                    boxes.erase(proxies[at]);
+                    broadphase->destroyProxy(proxies[at], nullptr);
+                    proxies.erase(proxies.begin() + long(at));
+                    create();
+                }
+                if (frame % 13 == 5) {  // an unmoved proxy stops colliding with group 1
+                    proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
+                }
+                const FramePairs pairs =
+                    searchPairs(*broadphase, boxes,
+                                filters == FilterEvaluation::WhenAdded ? &admitted : nullptr);
+                ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+                pairsSeen += pairs.truth.size();
             }
-            const FramePairs pairs = searchPairs(*broadphase, boxes);
-            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
-            pairsSeen += pairs.truth.size();
+            auto* adapter = dynamic_cast<BroadphaseAdapter*>(broadphase.get());
+            ASSERT_NE(adapter, nullptr);
+            adapter->validate();
+            // Meaningful: pairs existed, and both kinds of search ran many times.
+            EXPECT_GT(pairsSeen, 150u * 20);
+            EXPECT_GT(adapter->stats().incrementalSearches, 100u);
+            EXPECT_LT(adapter->stats().incrementalSearches, 140u);
         }
-        auto* adapter = dynamic_cast<BroadphaseAdapter*>(broadphase.get());
-        ASSERT_NE(adapter, nullptr);
-        adapter->validate();
-        // Meaningful: pairs existed, and both kinds of search ran many times.
-        EXPECT_GT(pairsSeen, 150u * 20);
-        EXPECT_GT(adapter->stats().incrementalSearches, 100u);
-        EXPECT_LT(adapter->stats().incrementalSearches, 140u);
-    }
 }
 
 // Fat boxes: slow objects get enlarged core boxes and jitter inside them without a core
@@ -453,6 +547,7 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
             BroadphaseSettings settings;
             settings.fatMargin = margin;
             auto broadphase = makeBroadphase(name, settings);
+            AdmittedPairs admitted;
             std::mt19937 random(11);
             std::uniform_real_distribution<double> unit(0, 1);
             // A 10x10x4 lattice of touching unit boxes: the jitter makes neighbours overlap
@@ -490,7 +585,7 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
                 if (frame % 17 == 8) {  // a jittering proxy stops colliding with group 1
                     proxies[random() % proxies.size()]->m_collisionFilterMask ^= 1;
                 }
-                const FramePairs pairs = searchPairs(*broadphase, boxes);
+                const FramePairs pairs = searchPairs(*broadphase, boxes, &admitted);
                 ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
                 overlapsSeen += pairs.truth.size();
 

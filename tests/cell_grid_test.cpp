@@ -101,6 +101,7 @@ TEST(CellGrid, CellSizeIsReChosenWhenThePopulationDrifts) {
     std::vector<Aabb<3, double>> boxes;
     std::size_t frames = 0;
     auto frame = [&] {
+        hash.maintain();
         hash.findCandidates([](ObjectId, ObjectId) {});
         ++frames;
     };
@@ -139,6 +140,7 @@ TEST(CellGrid, DenseGridKeepsObjectsThatLeaveTheRegionAndReChoosesIt) {
             grid.update(id, {{x, 0, 0}, {x + 1, 1, 1}});
         }
         pairs = 0;
+        grid.maintain();
         grid.findCandidates([&](ObjectId a, ObjectId b) { pairs += (a / 2 == b / 2) ? 1 : 0; });
         grid.validate();
     }

@@ -244,6 +244,7 @@ CoreScenarioResult runCoreScenario(Core& core, const CoreScenario& scenario) {
         // Pairs.
         std::set<std::pair<ObjectId, ObjectId>> reported;
         bool duplicate = false, dead = false;
+        core.maintain();
         core.findCandidates([&](ObjectId a, ObjectId b) {
             ++result.candidates;
             if (a >= live.size() || b >= live.size() || !live[a] || !live[b] || a == b) {

@@ -59,6 +59,7 @@ class CheckedTreeCore {
     }
     std::size_t size() const { return core_.size(); }
     void validate() const { core_.validate(); }
+    void maintain() { core_.maintain(); }
     const Core& core() const { return core_; }
 
     template <class Sink>

@@ -14,13 +14,48 @@ namespace kolize {
 namespace {
 
 constexpr std::size_t kDefaultReportsPrinted = 16;
-constexpr std::size_t kMaxPendingFree = 4096;
 
 void appendVector(std::ostringstream& out, const btVector3& v) {
     out << '(' << v.x() << ", " << v.y() << ", " << v.z() << ')';
 }
 
 }  // namespace
+
+// The pair certificates (see travel_ in the header) are decided in double with every
+// rounding taken in the safe direction: motion and travel rounded up, slack and shares
+// rounded down. Each factor removes more than one rounding step can add.
+constexpr double kUp = 1 + 0x1p-51;
+constexpr double kDown = 1 - 0x1p-51;
+
+double BroadphaseAdapter::motion(const Box& from, const Box& to) {
+    double most = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        most = std::max({most, std::fabs(double(to.lo[axis]) - double(from.lo[axis])),
+                         std::fabs(double(to.hi[axis]) - double(from.hi[axis]))});
+    }
+    return most * kUp;
+}
+
+bool BroadphaseAdapter::overlapWithSlack(const Box& a, const Box& b, double& slack) {
+    // Per axis the overlap of the two intervals (negative: the gap). Overlapping: the pair
+    // stays so while every axis' overlap stays >= 0, i.e. while the two boxes' motions sum
+    // to less than the smallest overlap. Apart: it stays so while they sum to less than
+    // the widest gap. The sign is exact in double (a rounded difference keeps its sign),
+    // so the decision is the closed-interval test.
+    double least = HUGE_VAL, widestGap = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double overlap = std::min(double(a.hi[axis]), double(b.hi[axis])) -
+                               std::max(double(a.lo[axis]), double(b.lo[axis]));
+        if (overlap >= 0) {
+            least = std::min(least, overlap);
+        } else {
+            widestGap = std::max(widestGap, -overlap);
+        }
+    }
+    const bool overlapping = widestGap == 0;
+    slack = (overlapping ? least : widestGap) * kDown;
+    return overlapping;
+}
 
 std::string BadAabbReport::message() const {
     std::ostringstream out;
@@ -136,7 +171,9 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
         boxes_.emplace_back();
         fat_.emplace_back();
         state_.push_back(SlotState::Free);
-        movedFlag_.push_back(0);
+        movedKind_.push_back(0);
+        frameKind_.push_back(0);
+        travel_.push_back(0);
     }
     Proxy* proxy = proxyOf(slot);
     proxy->m_clientObject = userPtr;
@@ -158,8 +195,9 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
     state_[slot] = SlotState::Live;
     boxes_[slot] = toBox(aabbMin, aabbMax);
     fat_[slot] = boxes_[slot];
+    travel_[slot] = 0;
     coreInsert(slot, fat_[slot]);
-    noteMoved(slot);
+    noteMoved(slot, kExactMoved | kCoreMoved);
     return proxy;
 }
 
@@ -175,34 +213,85 @@ BroadphaseAdapter::Proxy* BroadphaseAdapter::checkedProxy(btBroadphaseProxy* pro
     return ours;
 }
 
+bool BroadphaseAdapter::cacheHoldsOnlyOurs() const {
+    return std::size_t(pairCache_->getNumOverlappingPairs()) == cached_;
+}
+
+void BroadphaseAdapter::uncache(std::uint32_t at, btDispatcher* dispatcher) {
+    PairStore::Pair& pair = pairs_[at];
+    if (pair.status == PairStore::Status::Apart) {
+        return;
+    }
+    const bool wasCached = pair.status == PairStore::Status::InCache;
+    pair.status = PairStore::Status::Apart;
+    --overlapping_;
+    if (wasCached) {
+        --cached_;
+        ++counters_.pairsRemoved;
+        pairCache_->removeOverlappingPair(proxyOf(pair.object[0]), proxyOf(pair.object[1]),
+                                          dispatcher);
+    }
+}
+
 void BroadphaseAdapter::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) {
     Proxy* ours = checkedProxy(proxy, "destroyProxy");
-    pairCache_->removeOverlappingPairsContainingProxy(ours, dispatcher);
     const ObjectId slot = ours->slot;
+    // While this runs, callbacks of the pair cache may destroy other proxies: their pairs
+    // are then erased at the end, so that this walk over the slot's pairs stays valid.
+    ++deferErasures_;
+    const std::vector<std::uint32_t>& own = pairs_.pairsOf(slot);
+    if (cacheHoldsOnlyOurs()) {
+        for (std::size_t i = 0; i < own.size(); ++i) {
+            uncache(own[i], dispatcher);
+        }
+    } else {
+        // Someone else's pairs may name this proxy too: only the cache can find them all.
+        for (std::size_t i = 0; i < own.size(); ++i) {
+            forget(own[i]);
+        }
+        pairCache_->removeOverlappingPairsContainingProxy(ours, dispatcher);
+    }
     if (state_[slot] == SlotState::Live) {
         coreRemove(slot);
     } else {
         --parkedCount_;
     }
-    // The slot's entries in pairs_ go stale at the next frame; keeping the slot out of reuse
-    // until then means a new proxy never inherits them.
     state_[slot] = SlotState::PendingFree;
     pendingFree_.push_back(slot);
     ours->m_clientObject = nullptr;
     --liveCount_;
-    if (pendingFree_.size() > kMaxPendingFree) {
-        // An app that creates and destroys without ever computing pairs must not grow
-        // without bound: drop the destroyed slots' pairs now and release the slots.
-        pairs_.retainIf([&](const PairSet::Entry& entry) {
-            return state_[entry.first()] != SlotState::PendingFree &&
-                   state_[entry.second()] != SlotState::PendingFree;
-        });
+    --deferErasures_;
+    if (deferErasures_ == 0 && !searching_) {
         releasePendingSlots();
     }
 }
 
+void BroadphaseAdapter::forget(std::uint32_t at) {
+    PairStore::Pair& pair = pairs_[at];
+    if (pair.status != PairStore::Status::Apart) {
+        const bool cached = pair.status == PairStore::Status::InCache;
+        cached_ -= cached ? 1 : 0;
+        counters_.pairsRemoved += cached ? 1 : 0;
+        --overlapping_;
+        pair.status = PairStore::Status::Apart;
+    }
+}
+
+void BroadphaseAdapter::erasePairs(std::vector<std::uint32_t>& doomed) {
+    // Descending: erasing moves the last pair into the hole, never one still to erase.
+    std::sort(doomed.begin(), doomed.end(), std::greater<std::uint32_t>());
+    doomed.erase(std::unique(doomed.begin(), doomed.end()), doomed.end());
+    for (std::uint32_t at : doomed) {
+        pairs_.erase(at);
+    }
+    doomed.clear();
+}
+
 void BroadphaseAdapter::releasePendingSlots() {
     for (ObjectId slot : pendingFree_) {
+        const std::vector<std::uint32_t>& own = pairs_.pairsOf(slot);  // all Apart by now
+        doomed_.assign(own.begin(), own.end());
+        erasePairs(doomed_);
         state_[slot] = SlotState::Free;
         freeSlots_.push_back(slot);
     }
@@ -211,40 +300,46 @@ void BroadphaseAdapter::releasePendingSlots() {
 
 void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin,
                                 const btVector3& aabbMax, btDispatcher* /*dispatcher*/) {
-    Proxy* ours = static_cast<Proxy*>(proxy);
+    Proxy* ours = checkedProxy(proxy, "setAabb");
     const ObjectId slot = ours->slot;
     const char* reason = rejectReason(aabbMin, aabbMax);
     if (*reason != '\0') {
-        reportBadAabb("setAabb", *checkedProxy(proxy, "setAabb"), aabbMin, aabbMax, reason);
+        reportBadAabb("setAabb", *ours, aabbMin, aabbMax, reason);
         return;
     }
     const Box box = toBox(aabbMin, aabbMax);
-    if (state_[slot] == SlotState::Live && box == boxes_[slot]) {
-        return;  // unchanged (resting and sleeping bodies): nothing to do
-    }
     if (state_[slot] == SlotState::Live) {
+        if (box == boxes_[slot]) {
+            return;  // unchanged (resting and sleeping bodies): nothing to do
+        }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
+        travel_[slot] = (travel_[slot] + motion(boxes_[slot], box)) * kUp;
         if (contains(fat_[slot], box)) {
-            boxes_[slot] = box;  // the core box still holds it: only the exact tests change
+            // The core box still holds it: no new candidates. Its pairs need a look only
+            // once it has travelled its share of one of their slacks.
+            boxes_[slot] = box;
             ++counters_.movesInsideFatBoxes;
+            if (travel_[slot] > pairs_.nextTrigger(slot)) {
+                noteMoved(slot, kExactMoved);
+            }
             return;
         }
         fat_[slot] = fatBox(box, boxes_[slot]);
         boxes_[slot] = box;
         coreUpdate(slot, fat_[slot]);
     } else {
-        checkedProxy(proxy, "setAabb");
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
         state_[slot] = SlotState::Live;
         --parkedCount_;
         boxes_[slot] = box;
         fat_[slot] = box;
+        travel_[slot] = 0;
         coreInsert(slot, fat_[slot]);
     }
     ++counters_.coreUpdates;
-    noteMoved(slot);
+    noteMoved(slot, kExactMoved | kCoreMoved);
 }
 
 BroadphaseAdapter::Box BroadphaseAdapter::fatBox(const Box& box, const Box& previous) const {
@@ -296,6 +391,16 @@ void BroadphaseAdapter::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax
     aabbMax.setValue(all.hi[0], all.hi[1], all.hi[2]);
 }
 
+bool BroadphaseAdapter::usableQueryBox(const btVector3& aabbMin, const btVector3& aabbMax) {
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!(aabbMin[axis] <= aabbMax[axis])) {  // inverted, or NaN
+            ++counters_.emptyQueries;
+            return false;
+        }
+    }
+    return true;
+}
+
 Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
                                           const btBroadphaseRayCallback& callback,
                                           const btVector3& aabbMin, const btVector3& aabbMax) {
@@ -303,7 +408,7 @@ Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
     for (int axis = 0; axis < 3; ++axis) {
         ray.origin[axis] = rayFrom[axis];
         ray.inverseDirection[axis] = callback.m_rayDirectionInverse[axis];
-        ray.sign[axis] = callback.m_signs[axis];
+        ray.sign[axis] = callback.m_signs[axis] ? 1u : 0u;
         ray.expandLo[axis] = aabbMin[axis];
         ray.expandHi[axis] = aabbMax[axis];
     }
@@ -311,67 +416,273 @@ Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
     return ray;
 }
 
-void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candidates,
-                                    bool incremental) {
-    const std::uint32_t stamp = stamp_;
-    std::size_t overlapping = 0;
-    pairs_.retainIf([&](PairSet::Entry& entry) {
-        Proxy* a = proxyOf(entry.first());
-        Proxy* b = proxyOf(entry.second());
-        if (entry.stamp != stamp && incremental && !movedFlag_[entry.first()] &&
-            !movedFlag_[entry.second()] && state_[entry.first()] == SlotState::Live &&
-            state_[entry.second()] == SlotState::Live) {
-            entry.stamp = stamp;  // neither core box changed: still a candidate
+std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery() {
+    // A deque: a nested query's new level does not move the lists of the levels below.
+    if (queryDepth_ == queryScratch_.size()) {
+        queryScratch_.emplace_back();
+    }
+    std::vector<QueryHit>& hits = queryScratch_[queryDepth_++];
+    hits.clear();
+    return hits;
+}
+
+bool BroadphaseAdapter::beginPairs() {
+    searching_ = true;
+    if (++stamp_ == 0) {  // wrapped: no pair may look tested in this frame
+        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+            pairs_[at].stamp = 0;
+            pairs_[at].tested = 0;
         }
-        if (entry.stamp != stamp) {
-            // Destroyed proxies already had their pairs removed by destroyProxy.
-            const bool bothAlive = state_[entry.first()] != SlotState::PendingFree &&
-                                   state_[entry.second()] != SlotState::PendingFree;
-            if (entry.inCache && bothAlive) {
-                pairCache_->removeOverlappingPair(a, b, dispatcher);
-                ++counters_.pairsRemoved;
-            }
-            return false;
-        }
-        const bool overlap = overlaps(boxes_[entry.first()], boxes_[entry.second()]);
-        overlapping += overlap ? 1 : 0;
-        const bool wanted = overlap && pairCache_->needsBroadphaseCollision(a, b);
-        if (wanted && !entry.inCache) {
-            entry.inCache = pairCache_->addOverlappingPair(a, b) != nullptr;
-            counters_.pairsAdded += entry.inCache ? 1 : 0;
-        } else if (!wanted && entry.inCache) {
-            pairCache_->removeOverlappingPair(a, b, dispatcher);
-            entry.inCache = false;
-            ++counters_.pairsRemoved;
-        }
-        return true;
-    });
-    releasePendingSlots();
+        stamp_ = 1;
+    }
+    processing_.clear();
+    std::size_t coreMoved = 0;
     for (ObjectId slot : moved_) {
-        movedFlag_[slot] = 0;
+        const std::uint8_t kind = movedKind_[slot];
+        movedKind_[slot] = 0;
+        if (state_[slot] != SlotState::Live) {
+            continue;
+        }
+        processing_.push_back(Moved{slot, kind});
+        frameKind_[slot] = kind;
+        coreMoved += (kind & kCoreMoved) != 0 ? 1 : 0;
     }
     moved_.clear();
-    framesSinceFullSearch_ = incremental ? framesSinceFullSearch_ + 1 : 0;
-    counters_.incrementalSearches += incremental ? 1 : 0;
+    checkCacheForLostPairs();
+    if (processing_.empty()) {
+        ++counters_.idleFrames;
+    }
+    // The core's all-pairs search pays when many objects moved (and on the first frame).
+    return counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
+}
+
+void BroadphaseAdapter::checkCacheForLostPairs() {
+    if (cacheHoldsOnlyOurs()) {
+        return;
+    }
+    // Someone else removed (or added) pairs: look ours up, and test again every pair that
+    // is gone, so it is added again if its boxes still overlap.
+    ++counters_.cacheChecks;
+    for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+        PairStore::Pair& pair = pairs_[at];
+        if (pair.status != PairStore::Status::InCache ||
+            pairCache_->findPair(proxyOf(pair.object[0]), proxyOf(pair.object[1])) != nullptr) {
+            continue;
+        }
+        pair.status = PairStore::Status::Apart;
+        pair.slack = -1;  // its status is unknown: test it
+        --cached_;
+        --overlapping_;
+        ++counters_.pairsRestored;
+        for (int side = 0; side < 2; ++side) {
+            const ObjectId id = pair.object[side];
+            pairs_.setTrigger(at, side, -HUGE_VAL);
+            if (frameKind_[id] == 0) {
+                processing_.push_back(Moved{id, kExactMoved});
+            }
+            frameKind_[id] |= kExactMoved;
+        }
+    }
+}
+
+void BroadphaseAdapter::dropLeftCandidates(ObjectId id, btDispatcher* dispatcher) {
+    const Box& box = fat_[id];
+    // Uncaching calls back into Bullet, whose callbacks may destroy proxies: collect first,
+    // erase after.
+    ++deferErasures_;
+    const std::vector<std::uint32_t>& own = pairs_.pairsOf(id);
+    for (std::size_t i = 0; i < own.size(); ++i) {
+        const std::uint32_t at = own[i];
+        if (!overlaps(box, fat_[pairs_[at].other(id)])) {
+            uncache(at, dispatcher);
+            doomed_.push_back(at);
+        }
+    }
+    --deferErasures_;
+    erasePairs(doomed_);
+}
+
+void BroadphaseAdapter::share(std::uint32_t at, double slack) {
+    // The objects split what is left in proportion to how far each travelled since the
+    // test (an object at rest leaves it to the other); while both stay within their
+    // shares, the two travel less than the slack together. Shares are rounded down.
+    // (Below 1e-300 the factor could not round down: such a share counts as none.)
+    const PairStore::Pair& pair = pairs_[at];
+    const double moved[2] = {travel_[pair.object[0]] - pair.travelled[0],
+                             travel_[pair.object[1]] - pair.travelled[1]};
+    const double floor = (moved[0] + moved[1]) / 8;
+    double weight[2] = {moved[0] + floor, moved[1] + floor};
+    if (!(weight[0] + weight[1] > 0)) {
+        weight[0] = weight[1] = 1;
+    }
+    for (int side = 0; side < 2; ++side) {
+        const ObjectId id = pair.object[side];
+        const double part = slack * (weight[side] / (weight[0] + weight[1])) * kDown * kDown;
+        // Not below the odometer: a share lost to rounding (a huge odometer) is no share.
+        const double trigger = part >= 1e-300 ? (travel_[id] + part) * kDown : travel_[id];
+        pairs_.setTrigger(at, side, trigger >= travel_[id] ? trigger : travel_[id]);
+    }
+}
+
+void BroadphaseAdapter::lookAtPair(std::uint32_t at, btDispatcher* dispatcher, bool retestFilter) {
+    PairStore::Pair& pair = pairs_[at];
+    pair.tested = stamp_;
+    const ObjectId a = pair.object[0], b = pair.object[1];
+    if (state_[a] != SlotState::Live || state_[b] != SlotState::Live) {
+        // Destroyed during this search: erased at its end; meanwhile never due.
+        pairs_.setTrigger(at, 0, HUGE_VAL);
+        pairs_.setTrigger(at, 1, HUGE_VAL);
+        return;
+    }
+    const double used = ((travel_[a] - pair.travelled[0]) + (travel_[b] - pair.travelled[1])) * kUp;
+    if (pair.slack >= 0 && used < pair.slack) {
+        // The certificate holds: the status is what it was. Share what is left afresh.
+        share(at, (pair.slack - used) * kDown);
+        if (retestFilter && pairs_[at].status != PairStore::Status::Apart) {
+            applyFilter(at, true, dispatcher);
+        }
+        return;
+    }
+    ++testedThisFrame_;
+    double slack = 0;
+    const bool overlap = overlapWithSlack(boxes_[a], boxes_[b], slack);
+    pair.slack = slack;
+    pair.travelled[0] = travel_[a];
+    pair.travelled[1] = travel_[b];
+    share(at, slack);
+    switch (pairs_[at].status) {
+        case PairStore::Status::Apart:
+            if (overlap) {
+                ++overlapping_;
+                applyFilter(at, false, dispatcher);
+            }
+            return;
+        case PairStore::Status::InCache:
+            if (!overlap) {
+                uncache(at, dispatcher);
+            } else if (retestFilter) {
+                applyFilter(at, true, dispatcher);
+            }
+            return;
+        case PairStore::Status::Rejected:
+            if (!overlap) {
+                pairs_[at].status = PairStore::Status::Apart;
+                --overlapping_;
+            } else if (retestFilter) {
+                applyFilter(at, true, dispatcher);
+            }
+            return;
+    }
+}
+
+void BroadphaseAdapter::lookAtDuePairs(ObjectId id, btDispatcher* dispatcher, bool retestFilter) {
+    // The heap's first pair is the one whose trigger the object passed first; a look sets
+    // the triggers at or above the odometer, so the loop ends.
+    for (std::uint32_t at = pairs_.firstDue(id); at != PairStore::kNone; at = pairs_.firstDue(id)) {
+        if (!(pairs_[at].trigger[pairs_[at].sideOf(id)] < travel_[id])) {
+            break;
+        }
+        lookAtPair(at, dispatcher, retestFilter);
+    }
+}
+
+void BroadphaseAdapter::applyFilter(std::uint32_t at, bool again, btDispatcher* dispatcher) {
+    PairStore::Pair& pair = pairs_[at];
+    Proxy* a = proxyOf(pair.object[0]);
+    Proxy* b = proxyOf(pair.object[1]);
+    if (pair.status == PairStore::Status::InCache) {
+        if (again && !pairCache_->needsBroadphaseCollision(a, b)) {
+            uncache(at, dispatcher);
+            pairs_[at].status = PairStore::Status::Rejected;
+            ++overlapping_;
+        }
+        return;
+    }
+    // A pair that starts overlapping (or a rejected one, looked at again): the cache
+    // evaluates the filters, as Bullet's own broadphases let it.
+    pair.status = PairStore::Status::Rejected;
+    if (pairCache_->addOverlappingPair(a, b) != nullptr) {
+        pairs_[at].status = PairStore::Status::InCache;
+        ++cached_;
+        ++counters_.pairsAdded;
+    }
+}
+
+void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, bool full, std::size_t candidates) {
+    const bool everyFrame = settings_.filters == FilterEvaluation::EveryFrame;
+    testedThisFrame_ = 0;
+    // No pair is erased until the end (callbacks may destroy proxies): indices hold.
+    ++deferErasures_;
+    if (full) {
+        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+            if (pairs_[at].stamp != stamp_) {
+                uncache(at, dispatcher);  // the core boxes no longer overlap
+                doomed_.push_back(at);
+            } else if (pairs_[at].slack < 0) {
+                lookAtPair(at, dispatcher, everyFrame);
+            }
+        }
+    }
+    for (const Moved& moved : processing_) {
+        if (state_[moved.slot] == SlotState::Live) {
+            lookAtDuePairs(moved.slot, dispatcher, everyFrame);
+        }
+    }
+    if (everyFrame) {
+        // The pairs nobody looked at: their status stands, their filters are asked again.
+        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+            const PairStore::Pair& pair = pairs_[at];
+            if (pair.tested != stamp_ && pair.status != PairStore::Status::Apart &&
+                state_[pair.object[0]] == SlotState::Live &&
+                state_[pair.object[1]] == SlotState::Live) {
+                applyFilter(at, true, dispatcher);
+            }
+        }
+    }
+    --deferErasures_;
+    erasePairs(doomed_);
+    for (const Moved& moved : processing_) {
+        frameKind_[moved.slot] = 0;
+    }
+    searching_ = false;
+    if (deferErasures_ == 0) {
+        releasePendingSlots();
+    }
+    counters_.incrementalSearches += full ? 0 : 1;
+    counters_.fullSearches += full ? 1 : 0;
     ++counters_.frames;
     counters_.candidatesLastFrame = candidates;
-    counters_.overlappingPairs = overlapping;
+    counters_.pairsTestedLastFrame = testedThisFrame_;
+    counters_.objectsLookedAtLastFrame = processing_.size();
 }
 
 void BroadphaseAdapter::resetPool(btDispatcher* /*dispatcher*/) {
-    if (liveCount_ != 0) {
+    if (liveCount_ != 0 || searching_ || deferErasures_ != 0) {
         return;
     }
-    chunks_.clear();
-    boxes_.clear();
-    fat_.clear();
-    state_.clear();
-    freeSlots_.clear();
-    pendingFree_.clear();
+    // Swapping with empty vectors frees their memory (clear() would keep the capacity).
+    std::vector<std::unique_ptr<Proxy[]>>().swap(chunks_);
+    std::vector<Box>().swap(boxes_);
+    std::vector<Box>().swap(fat_);
+    std::vector<SlotState>().swap(state_);
+    std::vector<ObjectId>().swap(freeSlots_);
+    std::vector<ObjectId>().swap(pendingFree_);
+    std::vector<ObjectId>().swap(moved_);
+    std::vector<std::uint8_t>().swap(movedKind_);
+    std::vector<std::uint8_t>().swap(frameKind_);
+    std::vector<double>().swap(travel_);
+    std::vector<std::uint32_t>().swap(doomed_);
+    std::vector<Moved>().swap(processing_);
+    if (queryDepth_ == 0) {
+        queryScratch_.clear();
+        queryScratch_.shrink_to_fit();
+    }
     pairs_.clear();
-    moved_.clear();
-    movedFlag_.clear();
+    overlapping_ = 0;
+    cached_ = 0;
+    coreReset();
     nextUid_ = 1;
+    ++generation_;
 }
 
 AdapterStats BroadphaseAdapter::stats() const {
@@ -380,29 +691,45 @@ AdapterStats BroadphaseAdapter::stats() const {
     out.parkedProxies = parkedCount_;
     out.slots = boxes_.size();
     out.candidatePairs = pairs_.size();
-    out.memoryBytes = chunks_.size() * (sizeof(Proxy) << kChunkBits) +
-                      (boxes_.capacity() + fat_.capacity()) * sizeof(Box) + state_.capacity() +
-                      (freeSlots_.capacity() + pendingFree_.capacity()) * sizeof(ObjectId) +
-                      pairs_.memoryBytes() + coreMemoryBytes();
+    out.overlappingPairs = overlapping_;
+    out.cachedPairs = cached_;
+    std::size_t scratch = 0;
+    for (const std::vector<QueryHit>& hits : queryScratch_) {
+        scratch += hits.capacity() * sizeof(QueryHit);
+    }
+    out.memoryBytes =
+        chunks_.size() * (sizeof(Proxy) << kChunkBits) +
+        (boxes_.capacity() + fat_.capacity()) * sizeof(Box) + state_.capacity() +
+        movedKind_.capacity() + frameKind_.capacity() + travel_.capacity() * sizeof(double) +
+        doomed_.capacity() * sizeof(std::uint32_t) +
+        (freeSlots_.capacity() + pendingFree_.capacity() + moved_.capacity()) * sizeof(ObjectId) +
+        processing_.capacity() * sizeof(Moved) + scratch + pairs_.memoryBytes() + coreMemoryBytes();
     return out;
 }
 
 void BroadphaseAdapter::printStats() {
     const AdapterStats s = stats();
     std::printf(
-        "kolize %s: %zu proxies (%zu parked), %zu overlapping pairs (%zu candidate pairs), %zu "
-        "frames (%zu incremental), %zu candidates last frame, %zu core updates, %zu moves "
-        "inside fat boxes, %zu pairs added, %zu removed, %zu bad AABBs rejected, %zu bytes\n",
-        name_.c_str(), s.proxies, s.parkedProxies, s.overlappingPairs, s.candidatePairs, s.frames,
-        s.incrementalSearches, s.candidatesLastFrame, s.coreUpdates, s.movesInsideFatBoxes,
-        s.pairsAdded, s.pairsRemoved, s.badAabbReports, s.memoryBytes);
+        "kolize %s: %zu proxies (%zu parked), %zu overlapping pairs (%zu cached, %zu candidate "
+        "pairs), %zu frames (%zu incremental, %zu full, %zu idle), %zu candidates and %zu pair "
+        "tests of %zu objects' pairs last frame, %zu core updates, %zu moves inside fat boxes, %zu "
+        "pairs added, %zu "
+        "removed, %zu restored after outside removal, %zu bad AABBs rejected, %zu empty "
+        "queries, %zu bytes\n",
+        name_.c_str(), s.proxies, s.parkedProxies, s.overlappingPairs, s.cachedPairs,
+        s.candidatePairs, s.frames, s.incrementalSearches, s.fullSearches, s.idleFrames,
+        s.candidatesLastFrame, s.pairsTestedLastFrame, s.objectsLookedAtLastFrame, s.coreUpdates,
+        s.movesInsideFatBoxes, s.pairsAdded, s.pairsRemoved, s.pairsRestored, s.badAabbReports,
+        s.emptyQueries, s.memoryBytes);
 }
 
 void BroadphaseAdapter::validate() const {
     auto fail = [&](const std::string& what) {
         throw std::logic_error("kolize " + name_ + ": validate: " + what);
     };
-    if (boxes_.size() != state_.size() || chunks_.size() << kChunkBits < boxes_.size()) {
+    if (boxes_.size() != state_.size() || chunks_.size() << kChunkBits < boxes_.size() ||
+        movedKind_.size() != boxes_.size() || frameKind_.size() != boxes_.size() ||
+        travel_.size() != boxes_.size()) {
         fail("slot arrays disagree");
     }
     std::size_t live = 0, parked = 0;
@@ -418,35 +745,68 @@ void BroadphaseAdapter::validate() const {
                     boxes_[slot].hi[2] != proxy->m_aabbMax.z()) {
                     fail("box of slot " + std::to_string(slot) + " invalid or out of sync");
                 }
+                if (movedKind_[slot] == 0 && !searching_ &&
+                    travel_[slot] > pairs_.nextTrigger(static_cast<ObjectId>(slot))) {
+                    fail("slot " + std::to_string(slot) +
+                         " travelled past its trigger without being noted");
+                }
+                if (!contains(fat_[slot], boxes_[slot])) {
+                    fail("core box of slot " + std::to_string(slot) + " does not contain its box");
+                }
                 break;
             case SlotState::Parked:
                 ++parked;
                 break;
             default:
+                if (pairs_.degree(static_cast<ObjectId>(slot)) != 0 && !searching_) {
+                    fail("dead slot " + std::to_string(slot) + " still has pairs");
+                }
                 break;
+        }
+        if (frameKind_[slot] != 0 && !searching_) {
+            fail("frame mark of slot " + std::to_string(slot) + " left behind");
         }
     }
     if (live + parked != liveCount_ || parked != parkedCount_) {
         fail("live/parked counts disagree with the slot table");
     }
     std::size_t flagged = 0;
-    for (std::uint8_t flag : movedFlag_) {
-        flagged += flag;
+    for (std::uint8_t kind : movedKind_) {
+        flagged += kind != 0 ? 1 : 0;
     }
-    if (movedFlag_.size() != boxes_.size() || flagged != moved_.size()) {
-        fail("moved list and flags disagree");
-    }
-    for (std::size_t slot = 0; slot < boxes_.size(); ++slot) {
-        if (state_[slot] == SlotState::Live && !contains(fat_[slot], boxes_[slot])) {
-            fail("core box of slot " + std::to_string(slot) + " does not contain its box");
-        }
+    if (flagged != moved_.size()) {
+        fail("moved list and marks disagree");
     }
     pairs_.validate();
-    pairs_.forEach([&](const PairSet::Entry& entry) {
-        if (entry.second() >= boxes_.size()) {
-            fail("pair names a slot out of range");
+    std::size_t overlapping = 0, cached = 0;
+    for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+        const PairStore::Pair& pair = pairs_[at];
+        const ObjectId a = pair.object[0], b = pair.object[1];
+        if (b >= boxes_.size() || state_[a] != SlotState::Live || state_[b] != SlotState::Live) {
+            if (!searching_) {
+                fail("pair names a slot that is not live");
+            }
+            continue;
         }
-    });
+        const bool pending = movedKind_[a] != 0 || movedKind_[b] != 0;
+        if (!overlaps(fat_[a], fat_[b]) && !pending) {
+            fail("candidate pair whose core boxes do not overlap");
+        }
+        if (pair.status != PairStore::Status::Apart) {
+            ++overlapping;
+            cached += pair.status == PairStore::Status::InCache ? 1 : 0;
+        }
+        // The slack budgets promise that a pair neither of whose objects awaits a test
+        // still has the status of its last test.
+        if (!pending &&
+            (pair.status != PairStore::Status::Apart) != overlaps(boxes_[a], boxes_[b])) {
+            fail("pair " + std::to_string(a) + "-" + std::to_string(b) +
+                 " has a stale status: its objects moved past their slack unnoticed");
+        }
+    }
+    if (overlapping != overlapping_ || cached != cached_) {
+        fail("pair status counts disagree");
+    }
     coreValidate();
 }
 

@@ -67,13 +67,19 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
         return std::make_unique<CoreBroadphase<BruteForce<3, btScalar>>>(std::string(name),
                                                                          settings);
     }
+    // The adapter keeps the candidate pairs between frames itself; the tree cores' own
+    // kept set would only duplicate that work.
     if (name == "segment-trees") {
-        return std::make_unique<CoreBroadphase<SegmentTreeSet<3, btScalar>>>(
-            std::string(name), settings, settings.segmentTrees);
+        SegmentTreeSettings trees = settings.segmentTrees;
+        trees.incremental = false;
+        return std::make_unique<CoreBroadphase<SegmentTreeSet<3, btScalar>>>(std::string(name),
+                                                                             settings, trees);
     }
     if (name == "range-tree") {
+        RangeTreeSettings tree = settings.rangeTree;
+        tree.incremental = false;
         return std::make_unique<CoreBroadphase<RangeTree<3, btScalar>>>(std::string(name), settings,
-                                                                        settings.rangeTree);
+                                                                        tree);
     }
     if (name == "dbvt") {
         return std::make_unique<btDbvtBroadphase>(settings.pairCache);

@@ -60,6 +60,28 @@ std::vector<UidPair> exactPairsNaive(const std::vector<ProxyBox>& boxes,
     return out;
 }
 
+std::vector<UidPair> AdmittedPairs::update(const std::vector<ProxyBox>& boxes,
+                                           const btOverlappingPairCache* filter) {
+    std::map<int, const btBroadphaseProxy*> byUid;
+    for (const ProxyBox& box : boxes) {
+        byUid[box.proxy->m_uniqueId] = box.proxy;
+    }
+    std::map<UidPair, bool> verdicts;
+    std::vector<UidPair> out;
+    for (const UidPair& pair : exactPairs(boxes, nullptr)) {
+        const auto known = verdicts_.find(pair);
+        const bool accepted = known != verdicts_.end()
+                                  ? known->second
+                                  : wanted(filter, byUid[pair.first], byUid[pair.second]);
+        verdicts.emplace(pair, accepted);
+        if (accepted) {
+            out.push_back(pair);
+        }
+    }
+    verdicts_.swap(verdicts);
+    return out;
+}
+
 std::vector<UidPair> cachedPairs(const btOverlappingPairCache& cache) {
     std::vector<UidPair> out;
     const int count = cache.getNumOverlappingPairs();

@@ -34,6 +34,9 @@ class BruteForce {
     /// Removes live object `id` in O(1).
     void remove(ObjectId id) { live_.remove(id); }
 
+    /// Nothing to tune.
+    void maintain() {}
+
     /// Calls `candidate(a, b)` once for every unordered pair of live objects.
     template <class Sink>
     void findCandidates(Sink&& candidate) const {

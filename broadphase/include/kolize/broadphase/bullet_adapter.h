@@ -3,32 +3,43 @@
 /// The one adapter that maps any kolize core onto btBroadphaseInterface.
 ///
 /// BroadphaseAdapter (not a template) owns what every broadphase needs: proxies with
-/// stable addresses and deterministic unique ids, the bad-AABB policy, and the pair diff,
-/// the only code that talks to btOverlappingPairCache. CoreBroadphase<Core> adds the
-/// core: candidates and queries come from it, the exact box test happens here, once per
-/// candidate.
+/// stable addresses and deterministic unique ids, the bad-AABB policy, the candidate pairs
+/// kept between frames (PairStore, each object's pairs in its own list), and the pair diff,
+/// the only code that talks to btOverlappingPairCache. CoreBroadphase<Core> adds the core:
+/// new candidates and queries come from it, the exact box test happens here.
+///
+/// Work per frame is proportional to what changed. A pair search looks only at the objects
+/// whose box changed since the last one: an object whose core box changed queries the core
+/// for new candidates and drops the candidates it left; every object whose exact box
+/// changed re-tests the exact boxes of its own candidate pairs. A pair of two objects whose
+/// boxes did not change is not visited, and a frame in which nothing moved (a sleeping
+/// world) costs O(1) beyond the setAabb comparisons. When more than a quarter of the
+/// objects changed their core boxes the core's own all-pairs search replaces the queries.
 ///
 /// Fat boxes (BroadphaseSettings::fatMargin): the core holds, per object, a box that
 /// contains the exact one; slow objects get an enlarged box, so a setAabb inside it changes
-/// nothing in the core. The adapter keeps every pair whose core boxes overlap (the
-/// candidate pairs) from frame to frame and tests the exact boxes of each one every frame.
+/// nothing in the core. Candidate pairs are the pairs whose core boxes overlap.
 ///
 /// Exactness contract: after calculateOverlappingPairs the pair cache holds exactly the
-/// pairs whose current AABBs overlap (closed intervals) and that pass the cache's filters
-/// (evaluated every frame, so changed groups, masks or filter callbacks take effect on the
-/// next frame). Only the difference from the previous frame goes through
-/// addOverlappingPair / removeOverlappingPair, so ghost callbacks see each change once and
-/// cached collision algorithms survive while a pair persists. A pair that someone else
-/// removes from the cache is not re-added until it stops and starts overlapping again.
+/// pairs whose current AABBs overlap (closed intervals) and whose filters accepted them
+/// (see BroadphaseSettings::filters: by default evaluated when a pair starts overlapping,
+/// as Bullet's own broadphases do). Only the difference from the previous frame goes
+/// through addOverlappingPair / removeOverlappingPair, so ghost callbacks see each change
+/// once and cached collision algorithms survive while a pair persists. A pair that someone
+/// else removed from the cache (removeOverlappingPairsContainingProxy, a user's
+/// removeOverlappingPair) while its boxes still overlap is found missing and added again at
+/// the next pair search.
 
 #include <kolize/broadphase/aabb.h>
-#include <kolize/broadphase/pair_set.h>
+#include <kolize/broadphase/pair_store.h>
 #include <kolize/broadphase/settings.h>
 
 #include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 
+#include <cmath>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,21 +48,28 @@ namespace kolize {
 
 /// Counters a kolize broadphase keeps (printStats() prints them).
 struct AdapterStats {
-    std::size_t proxies = 0;              ///< live proxies
-    std::size_t parkedProxies = 0;        ///< live proxies without a valid box yet
-    std::size_t slots = 0;                ///< proxy slots allocated: live, free or awaiting reuse
-    std::size_t overlappingPairs = 0;     ///< pairs whose AABBs overlapped at the last search
-                                          ///< (before filters)
-    std::size_t candidatePairs = 0;       ///< pairs whose core (fat) boxes overlap
-    std::size_t frames = 0;               ///< calculateOverlappingPairs calls
-    std::size_t candidatesLastFrame = 0;  ///< candidate pairs the core produced last frame
-    std::size_t incrementalSearches = 0;  ///< frames that queried only the moved objects
-    std::size_t movesInsideFatBoxes = 0;  ///< setAabb calls absorbed by a fat box, all time
-    std::size_t coreUpdates = 0;          ///< setAabb calls that changed a core box, all time
-    std::size_t pairsAdded = 0;           ///< addOverlappingPair calls that added, all frames
-    std::size_t pairsRemoved = 0;         ///< removeOverlappingPair calls, all frames
-    std::size_t badAabbReports = 0;       ///< rejected boxes, all time
-    std::size_t memoryBytes = 0;          ///< adapter + core, approximate
+    std::size_t proxies = 0;                   ///< live proxies
+    std::size_t parkedProxies = 0;             ///< live proxies without a valid box yet
+    std::size_t slots = 0;                     ///< proxy slots allocated: live or free
+    std::size_t overlappingPairs = 0;          ///< pairs whose AABBs overlap (before filters)
+    std::size_t cachedPairs = 0;               ///< pairs this broadphase put in the pair cache
+    std::size_t candidatePairs = 0;            ///< pairs whose core (fat) boxes overlap
+    std::size_t frames = 0;                    ///< calculateOverlappingPairs calls
+    std::size_t candidatesLastFrame = 0;       ///< candidates the core produced last frame
+    std::size_t pairsTestedLastFrame = 0;      ///< exact box tests of kept pairs last frame
+    std::size_t objectsLookedAtLastFrame = 0;  ///< objects whose pairs were visited last frame
+    std::size_t incrementalSearches = 0;       ///< frames that queried only the moved objects
+    std::size_t fullSearches = 0;              ///< frames that ran the core's all-pairs search
+    std::size_t idleFrames = 0;                ///< frames in which no box had changed
+    std::size_t movesInsideFatBoxes = 0;       ///< setAabb calls absorbed by a fat box, all time
+    std::size_t coreUpdates = 0;               ///< setAabb calls that changed a core box, all time
+    std::size_t pairsAdded = 0;                ///< addOverlappingPair calls that added, all frames
+    std::size_t pairsRemoved = 0;              ///< removeOverlappingPair calls, all frames
+    std::size_t pairsRestored = 0;             ///< pairs found removed by others and added again
+    std::size_t cacheChecks = 0;               ///< frames that looked up every cached pair
+    std::size_t badAabbReports = 0;            ///< rejected boxes, all time
+    std::size_t emptyQueries = 0;              ///< inverted or NaN query boxes (answered empty)
+    std::size_t memoryBytes = 0;               ///< adapter + core, approximate
 };
 
 class BroadphaseAdapter : public btBroadphaseInterface {
@@ -69,36 +87,62 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     btBroadphaseProxy* createProxy(const btVector3& aabbMin, const btVector3& aabbMax,
                                    int shapeType, void* userPtr, int collisionFilterGroup,
                                    int collisionFilterMask, btDispatcher* dispatcher) override;
-    /// Removes the proxy's pairs from the cache first; its memory is reused only after the
-    /// next calculateOverlappingPairs (or after 4096 destroys without one). Throws
-    /// std::invalid_argument for a foreign or already destroyed proxy.
+    /// Removes the proxy's pairs from the cache first (only its own pairs, in O(its pairs),
+    /// when every pair in the cache is one this broadphase added; else through
+    /// removeOverlappingPairsContainingProxy, which walks the cache). The slot may be
+    /// reused by the next createProxy. Throws std::invalid_argument for a proxy this
+    /// broadphase does not own or already destroyed.
     void destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) override;
-    /// A bad box is reported and ignored: the proxy keeps its last valid box.
+    /// A bad box is reported and ignored: the proxy keeps its last valid box. Throws
+    /// std::invalid_argument for a proxy this broadphase does not own.
     void setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, const btVector3& aabbMax,
                  btDispatcher* dispatcher) override;
     /// The last valid box (for a proxy still waiting for one: the rejected creation box).
     void getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVector3& aabbMax) const override;
+    /// Reports every live proxy whose box overlaps [aabbMin, aabbMax] (closed), once each.
+    /// An inverted box (min > max on some axis) or a NaN bound is empty: nothing is
+    /// reported. Re-entrant: the callback may create, destroy and move proxies and run
+    /// queries; the proxies reported are those whose boxes overlapped when the query
+    /// began, except any destroyed before its turn.
+    void aabbTest(const btVector3& aabbMin, const btVector3& aabbMax,
+                  btBroadphaseAabbCallback& callback) override = 0;
+    /// Reports every live proxy whose box, swept by [aabbMin, aabbMax], Bullet's own ray
+    /// test accepts for the callback's precomputed ray (m_rayDirectionInverse, m_signs,
+    /// m_lambda_max), once each. An inverted or NaN swept box is empty. Re-entrant as
+    /// aabbTest.
+    void rayTest(const btVector3& rayFrom, const btVector3& rayTo,
+                 btBroadphaseRayCallback& callback, const btVector3& aabbMin,
+                 const btVector3& aabbMax) override = 0;
     btOverlappingPairCache* getOverlappingPairCache() override { return pairCache_; }
     const btOverlappingPairCache* getOverlappingPairCache() const override { return pairCache_; }
     /// The union of all valid proxy boxes (zero box when there are none).
     void getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax) const override;
-    /// When no proxy is alive, frees all memory and restarts ids, for reproducible runs.
+    /// When no proxy is alive, frees all memory (adapter and core) and restarts ids, for
+    /// reproducible runs. Does nothing while proxies are alive.
     void resetPool(btDispatcher* dispatcher) override;
     void printStats() override;
 
     const std::string& name() const { return name_; }
     AdapterStats stats() const;
-    /// Checks proxy table, pair set and core invariants; throws std::logic_error.
+    /// Checks proxy table, pair store and core invariants; throws std::logic_error.
     void validate() const;
 
   protected:
     struct Proxy : btBroadphaseProxy {
         ObjectId slot = 0;
     };
+    /// A proxy a query reports, remembered by uid so that a callback that destroys it (and
+    /// reuses its slot) is noticed.
+    struct QueryHit {
+        ObjectId slot;
+        int uid;
+    };
 
     virtual void coreInsert(ObjectId id, const Box& box) = 0;
     virtual void coreUpdate(ObjectId id, const Box& box) = 0;
     virtual void coreRemove(ObjectId id) = 0;
+    /// Frees all the core's memory (a fresh core with the same settings).
+    virtual void coreReset() = 0;
     virtual void coreValidate() const = 0;
     virtual std::size_t coreMemoryBytes() const = 0;
 
@@ -106,6 +150,8 @@ class BroadphaseAdapter : public btBroadphaseInterface {
         return Box{{aabbMin.x(), aabbMin.y(), aabbMin.z()},
                    {aabbMax.x(), aabbMax.y(), aabbMax.z()}};
     }
+    /// False (and counted) for an inverted or NaN box.
+    bool usableQueryBox(const btVector3& aabbMin, const btVector3& aabbMax);
     static Ray<3, btScalar> toRay(const btVector3& rayFrom, const btBroadphaseRayCallback& callback,
                                   const btVector3& aabbMin, const btVector3& aabbMax);
 
@@ -115,43 +161,63 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     const Box& fatBoxOf(ObjectId id) const { return fat_[id]; }
     Proxy* proxyOf(ObjectId id) const { return &chunks_[id >> kChunkBits][id & kChunkMask]; }
 
-    /// True when this pair search may be incremental: only the objects whose core box
-    /// changed since the last search (at most a quarter of them) are queried, and the
-    /// candidate pairs between unchanged objects are kept. A full search runs at least every
-    /// kFullSearchEvery frames (the cores re-tune themselves there).
-    bool incrementalSearch() const {
-        return counters_.frames > 0 && framesSinceFullSearch_ < kFullSearchEvery &&
-               moved_.size() * 4 <= liveCount_;
+    /// Scratch for one query: collect the hits into it, then call reportHits. Queries
+    /// nest (a callback may query again); each level has its own list.
+    std::vector<QueryHit>& beginQuery();
+    void addHit(std::vector<QueryHit>& hits, ObjectId id) const {
+        hits.push_back(QueryHit{id, proxyOf(id)->m_uniqueId});
     }
-    /// Visits every live object whose core box changed since the last pair search.
+    template <class Callback>
+    void reportHits(std::vector<QueryHit>& hits, Callback& callback) {
+        const std::size_t generation = generation_;
+        for (std::size_t i = 0; i < hits.size() && generation == generation_; ++i) {
+            const QueryHit hit = hits[i];
+            if (hit.slot < state_.size() && state_[hit.slot] == SlotState::Live &&
+                proxyOf(hit.slot)->m_uniqueId == hit.uid) {
+                callback.process(proxyOf(hit.slot));
+            }
+        }
+        endQuery();
+    }
+
+    /// One pair search, driven by CoreBroadphase::calculateOverlappingPairs:
+    /// `const bool full = beginPairs();` then, when full, keepCandidate for every pair the
+    /// core's all-pairs search finds (whose core boxes overlap); else, for each object
+    /// forEachCoreMoved visits, dropLeftCandidates and keepCandidate for each object its
+    /// core query finds. Then finishPairs.
+    bool beginPairs();
+    /// True while a pair search or a destroyProxy of this broadphase is under way: a pair
+    /// search started from one of their callbacks does nothing.
+    bool busy() const { return searching_ || deferErasures_ != 0; }
     template <class Visit>
-    void forEachMoved(Visit&& visit) const {
-        for (ObjectId id : moved_) {
-            if (state_[id] == SlotState::Live) {
-                visit(id);
+    void forEachCoreMoved(Visit&& visit) const {
+        for (const Moved& moved : processing_) {
+            if ((moved.kind & kCoreMoved) != 0 && state_[moved.slot] == SlotState::Live) {
+                visit(moved.slot);
             }
         }
     }
-    /// Starts a frame of pair finding: call markCandidate for each pair whose core boxes
-    /// overlap (at least once), then finishPairs.
-    void beginPairs() { ++stamp_; }
-    void markCandidate(ObjectId a, ObjectId b) {
+    /// Drops the candidate pairs of `id` whose core boxes no longer overlap.
+    void dropLeftCandidates(ObjectId id, btDispatcher* dispatcher);
+    /// Keeps (a, b) as a candidate pair: their core boxes overlap.
+    void keepCandidate(ObjectId a, ObjectId b) {
         bool inserted = false;
-        pairs_.findOrInsert(a, b, inserted).stamp = stamp_;
+        pairs_[pairs_.findOrInsert(a, b, inserted)].stamp = stamp_;
     }
-    /// Tests the exact boxes of every candidate pair and applies the difference from the
-    /// previous frame to the pair cache. After an incremental search the candidate pairs
-    /// between two live objects whose core boxes did not change are kept without being
-    /// marked.
-    void finishPairs(btDispatcher* dispatcher, std::size_t candidates, bool incremental);
+    void finishPairs(btDispatcher* dispatcher, bool full, std::size_t candidates);
 
   private:
     enum class SlotState : std::uint8_t { Free, Live, Parked, PendingFree };
     static constexpr unsigned kChunkBits = 8;
     static constexpr ObjectId kChunkMask = (1u << kChunkBits) - 1;
-    static constexpr std::size_t kFullSearchEvery = 64;
+    static constexpr std::uint8_t kExactMoved = 1, kCoreMoved = 2;
+    struct Moved {
+        ObjectId slot;
+        std::uint8_t kind;
+    };
 
     Proxy* checkedProxy(btBroadphaseProxy* proxy, const char* operation) const;
+    /// Erases the pairs of the slots destroyed while erasing had to wait, frees the slots.
     void releasePendingSlots();
     /// Returns an empty string for a valid box, else the reason.
     static const char* rejectReason(const btVector3& aabbMin, const btVector3& aabbMax);
@@ -160,6 +226,41 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// The core box for `box`, which replaces `previous`: enlarged when the object moved
     /// less than the margin, else `box` itself.
     Box fatBox(const Box& box, const Box& previous) const;
+    /// The largest change of any bound, rounded up.
+    static double motion(const Box& from, const Box& to);
+    /// Whether the closed boxes overlap, and the motion (rounded down) that could change
+    /// that: the least per-axis overlap, or the widest gap.
+    static bool overlapWithSlack(const Box& a, const Box& b, double& slack);
+    /// Splits `slack` between the pair's two objects: the triggers at which each must look
+    /// at the pair again.
+    void share(std::uint32_t at, double slack);
+    void noteMoved(ObjectId slot, std::uint8_t kind) {
+        if (movedKind_[slot] == 0) {
+            moved_.push_back(slot);
+        }
+        movedKind_[slot] |= kind;
+    }
+    /// Brings pair `at` up to date (once per search): when its objects have travelled its
+    /// slack since its last test, tests the exact boxes again and applies the change to the
+    /// cache; `retestFilter` re-evaluates the filters of an overlapping pair
+    /// (FilterEvaluation::EveryFrame).
+    void lookAtPair(std::uint32_t at, btDispatcher* dispatcher, bool retestFilter);
+    /// Looks at every pair of `id` whose trigger its odometer has passed.
+    void lookAtDuePairs(ObjectId id, btDispatcher* dispatcher, bool retestFilter);
+    /// An overlapping pair not in the cache: the cache's filters decide whether it goes in.
+    /// One in the cache (`again`): out when the filters now reject it.
+    void applyFilter(std::uint32_t at, bool again, btDispatcher* dispatcher);
+    /// Takes pair `at` out of the cache if it is there (not erased from the store).
+    void uncache(std::uint32_t at, btDispatcher* dispatcher);
+    /// Marks pair `at` apart without telling the cache (it was removed there already).
+    void forget(std::uint32_t at);
+    /// Erases the pairs listed (any order, repeats allowed) and clears the list.
+    void erasePairs(std::vector<std::uint32_t>& doomed);
+    /// Every cached pair still in Bullet's cache? Re-tests the ones someone removed.
+    void checkCacheForLostPairs();
+    /// Whether every pair in Bullet's cache is one of ours (then ours can be removed one
+    /// by one).
+    bool cacheHoldsOnlyOurs() const;
 
     std::string name_;
     BroadphaseSettings settings_;
@@ -171,80 +272,113 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     std::vector<Box> fat_;
     std::vector<SlotState> state_;
     std::vector<ObjectId> freeSlots_;
-    std::vector<ObjectId> pendingFree_;
+    std::vector<ObjectId> pendingFree_;  ///< destroyed during a pair search
     int nextUid_ = 1;
     std::size_t liveCount_ = 0;
     std::size_t parkedCount_ = 0;
+    std::size_t generation_ = 0;  ///< counts resetPool calls that freed memory
 
-    void noteMoved(ObjectId slot) {
-        if (!movedFlag_[slot]) {
-            movedFlag_[slot] = 1;
-            moved_.push_back(slot);
-        }
-    }
-
-    PairSet pairs_;
+    PairStore pairs_;
     std::uint32_t stamp_ = 0;
+    std::size_t overlapping_ = 0;          ///< pairs with status InCache or Rejected
+    std::size_t cached_ = 0;               ///< pairs with status InCache
     std::vector<ObjectId> moved_;          ///< slots whose box changed since the last search
-    std::vector<std::uint8_t> movedFlag_;  ///< per slot: in moved_
-    std::size_t framesSinceFullSearch_ = 0;
+    std::vector<std::uint8_t> movedKind_;  ///< per slot: kExactMoved | kCoreMoved, 0: not in moved_
+    std::vector<Moved> processing_;        ///< the moved slots of the search under way
+    std::vector<std::uint8_t> frameKind_;  ///< per slot: its kind in processing_, during a search
+    /// Pair certificates. travel_: per slot, the largest change of any bound, summed over
+    /// its setAabb calls (an odometer, rounded up). A pair remembers its slack at its last
+    /// exact test and both odometers then (PairStore::Pair): its status cannot change
+    /// before the two have travelled the slack between them. The slack left is split
+    /// between them as triggers, odometer readings kept in each object's heap of pairs;
+    /// a setAabb whose travel passes the object's lowest trigger notes it, and only its due
+    /// pairs are looked at.
+    std::vector<double> travel_;
+    std::vector<std::uint32_t> doomed_;  ///< scratch: pairs to erase
+    bool searching_ = false;
+    /// > 0 while pair indices must hold (a walk that calls back into Bullet): destroyed
+    /// proxies' pairs are erased afterwards.
+    int deferErasures_ = 0;
+    std::size_t testedThisFrame_ = 0;
+    std::deque<std::vector<QueryHit>> queryScratch_;
+    std::size_t queryDepth_ = 0;
     AdapterStats counters_;
+
+    void endQuery() { --queryDepth_; }
 };
 
 /// A btBroadphaseInterface over a kolize core. `Core` provides insert / update / remove,
-/// findCandidates(sink) (each unordered candidate pair at most once), queryBox and
-/// queryRay (supersets of the answer), validate() and memoryBytes().
+/// maintain() (re-tuning, called before every pair search), findCandidates(sink) (each
+/// unordered candidate pair at most once), queryBox and queryRay (supersets of the
+/// answer), validate() and memoryBytes().
 template <class Core>
 class CoreBroadphase final : public BroadphaseAdapter {
   public:
     CoreBroadphase(std::string name, const BroadphaseSettings& settings,
                    const typename Core::Settings& coreSettings = {})
-        : BroadphaseAdapter(std::move(name), settings), core_(coreSettings) {}
+        : BroadphaseAdapter(std::move(name), settings),
+          coreSettings_(coreSettings),
+          core_(coreSettings) {}
 
     void calculateOverlappingPairs(btDispatcher* dispatcher) override {
+        if (busy()) {
+            return;
+        }
+        const bool full = beginPairs();
+        core_.maintain();
         std::size_t candidates = 0;
-        const bool incremental = incrementalSearch();
-        beginPairs();
-        if (incremental) {
-            forEachMoved([&](ObjectId moved) {
+        if (full) {
+            core_.findCandidates([&](ObjectId a, ObjectId b) {
+                ++candidates;
+                if (overlaps(fatBoxOf(a), fatBoxOf(b))) {
+                    keepCandidate(a, b);
+                }
+            });
+        } else {
+            // All drops first: they erase pairs, which would move the new pairs' indices.
+            forEachCoreMoved([&](ObjectId moved) { dropLeftCandidates(moved, dispatcher); });
+            forEachCoreMoved([&](ObjectId moved) {
                 const Box& box = fatBoxOf(moved);
                 core_.queryBox(box, [&](ObjectId id) {
                     ++candidates;
                     if (id != moved && overlaps(fatBoxOf(id), box)) {
-                        markCandidate(moved, id);
+                        keepCandidate(moved, id);
                     }
                 });
             });
-        } else {
-            core_.findCandidates([&](ObjectId a, ObjectId b) {
-                ++candidates;
-                if (overlaps(fatBoxOf(a), fatBoxOf(b))) {
-                    markCandidate(a, b);
-                }
-            });
         }
-        finishPairs(dispatcher, candidates, incremental);
+        finishPairs(dispatcher, full, candidates);
     }
 
     void aabbTest(const btVector3& aabbMin, const btVector3& aabbMax,
                   btBroadphaseAabbCallback& callback) override {
+        if (!usableQueryBox(aabbMin, aabbMax)) {
+            return;
+        }
         const Box query = toBox(aabbMin, aabbMax);
+        std::vector<QueryHit>& hits = beginQuery();
         core_.queryBox(query, [&](ObjectId id) {
             if (overlaps(boxOf(id), query)) {
-                callback.process(proxyOf(id));
+                addHit(hits, id);
             }
         });
+        reportHits(hits, callback);
     }
 
     void rayTest(const btVector3& rayFrom, const btVector3& /*rayTo*/,
                  btBroadphaseRayCallback& callback, const btVector3& aabbMin,
                  const btVector3& aabbMax) override {
+        if (!usableQueryBox(aabbMin, aabbMax)) {
+            return;
+        }
         const Ray<3, btScalar> ray = toRay(rayFrom, callback, aabbMin, aabbMax);
+        std::vector<QueryHit>& hits = beginQuery();
         core_.queryRay(ray, [&](ObjectId id) {
             if (rayHits(boxOf(id), ray)) {
-                callback.process(proxyOf(id));
+                addHit(hits, id);
             }
         });
+        reportHits(hits, callback);
     }
 
     const Core& core() const { return core_; }
@@ -253,9 +387,11 @@ class CoreBroadphase final : public BroadphaseAdapter {
     void coreInsert(ObjectId id, const Box& box) override { core_.insert(id, box); }
     void coreUpdate(ObjectId id, const Box& box) override { core_.update(id, box); }
     void coreRemove(ObjectId id) override { core_.remove(id); }
+    void coreReset() override { core_ = Core(coreSettings_); }
     void coreValidate() const override { core_.validate(); }
     std::size_t coreMemoryBytes() const override { return core_.memoryBytes(); }
 
+    typename Core::Settings coreSettings_;
     Core core_;
 };
 

@@ -94,6 +94,7 @@ class CellGrid {
     void update(ObjectId id, const Box& box) {
         Object& object = objects_[id];
         object.box = box;
+        contentDirty_ = true;  // the ray clip bounds may shrink
         if (object.state == State::Waiting) {
             return;
         }
@@ -113,6 +114,7 @@ class CellGrid {
 
     void remove(ObjectId id) {
         Object& object = objects_[id];
+        contentDirty_ = true;
         if (object.state == State::Waiting) {
             eraseFrom(waiting_, id);
         } else {
@@ -122,15 +124,22 @@ class CellGrid {
         --size_;
     }
 
-    /// Each candidate pair once: pairs sharing a canonical cell, overflow objects swept
-    /// against each other and looked up in the cells they cover.
-    template <class Sink>
-    void findCandidates(Sink&& candidate) {
+    /// Before every pair search: chooses the cell size at the first one, and re-chooses it
+    /// (re-binning every object) when the population has drifted. O(1) in most frames.
+    void maintain() {
         if (needsChoice()) {
             choose();
         }
         ++framesSinceChoice_;
-        contentDirty_ = true;
+    }
+
+    /// Each candidate pair once: pairs sharing a canonical cell, overflow objects swept
+    /// against each other and looked up in the cells they cover.
+    template <class Sink>
+    void findCandidates(Sink&& candidate) {
+        if (!chosen_) {
+            choose();
+        }
         index_.forEachLive([&](std::uint32_t cell, const CellRecord& record) {
             if (record.count < 2) {
                 return;

@@ -57,6 +57,13 @@ class RangeTree : public CellCore<RangeTree<D, Scalar>, D, Scalar> {
         }
     }
 
+    /// Before every pair search: re-tunes the leaf width when the population has grown, and
+    /// sorts the node lists that changed (queries read only their windows then).
+    void maintain() {
+        this->retuneBeforeFrame();
+        sortMarkedNodes();
+    }
+
     /// Calls `candidate(a, b)` once for every unordered pair of live objects whose cell
     /// boxes overlap on all axes.
     template <class Sink>

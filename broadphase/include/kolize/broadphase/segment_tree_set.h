@@ -58,6 +58,9 @@ class SegmentTreeSet : public CellCore<SegmentTreeSet<D, Scalar>, D, Scalar> {
                settings.incremental && settings.traversal == Settings::Traversal::Stabbing),
           settings_(settings) {}
 
+    /// Before every pair search: re-tunes the leaf width when the population has grown.
+    void maintain() { this->retuneBeforeFrame(); }
+
     /// Calls `candidate(a, b)` once for every unordered pair of live objects whose cell
     /// boxes overlap on all axes.
     template <class Sink>

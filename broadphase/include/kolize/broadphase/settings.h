@@ -32,6 +32,22 @@ struct BadAabbReport {
     std::string message() const;
 };
 
+/// When a kolize broadphase evaluates the collision filters of a pair (the pair cache's
+/// needsBroadphaseCollision: groups and masks, and the overlap filter callback).
+enum class FilterEvaluation {
+    /// When the pair starts overlapping, as Bullet's own broadphases do (the default). A
+    /// pair the filters rejected stays out of the cache while its boxes keep overlapping.
+    /// To change an object's filters, remove it from the world and add it again, or call
+    /// btCollisionWorld::refreshBroadphaseProxy: its new proxy's pairs are evaluated at the
+    /// next pair search. Changing m_collisionFilterGroup / Mask in place affects only pairs
+    /// that start overlapping later.
+    WhenAdded,
+    /// At every pair search, for every overlapping pair: groups, masks and the filter
+    /// callback may change in place and take effect at the next search. Costs one filter
+    /// evaluation per overlapping pair per frame (O(pairs) even when nothing moves).
+    EveryFrame,
+};
+
 /// Settings for kolize::makeBroadphase. Every field has a usable default.
 struct BroadphaseSettings {
     /// World bounds for Bullet's sweep-and-prune ("sap", "sap-noray", "sap32"). SAP quantises
@@ -62,6 +78,8 @@ struct BroadphaseSettings {
     /// only add candidates). The pairs reported are exact either way. 0 turns fat boxes off;
     /// the factory accepts 0..10.
     btScalar fatMargin = btScalar(0.05);
+    /// When filters are evaluated (kolize's own broadphases); see FilterEvaluation.
+    FilterEvaluation filters = FilterEvaluation::WhenAdded;
 
     /// Cell size, region and overflow rules of "grid", "spatial-tree" and "spatial-hash".
     CellGridSettings cells;

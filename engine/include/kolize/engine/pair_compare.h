@@ -7,6 +7,7 @@
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
 
 #include <cstdint>
+#include <map>
 #include <utility>
 #include <vector>
 
@@ -37,6 +38,21 @@ std::vector<UidPair> exactPairs(const std::vector<ProxyBox>& boxes,
 /// The same by testing every pair: O(N^2). The reference for exactPairs itself.
 std::vector<UidPair> exactPairsNaive(const std::vector<ProxyBox>& boxes,
                                      const btOverlappingPairCache* filter);
+
+/// Bullet's filter contract, as a model to test against: a pair's filters are evaluated when
+/// its boxes start overlapping, with the filters of that moment, and the verdict holds while
+/// the boxes keep overlapping (BroadphaseSettings::filters = WhenAdded; Bullet's own
+/// broadphases). Feed it the boxes after every pair search.
+class AdmittedPairs {
+  public:
+    /// The pairs that belong in the cache now, sorted: overlapping, and accepted by
+    /// `filter` (none when null) when their current overlap began.
+    std::vector<UidPair> update(const std::vector<ProxyBox>& boxes,
+                                const btOverlappingPairCache* filter);
+
+  private:
+    std::map<UidPair, bool> verdicts_;  ///< overlapping pairs and their filter verdicts
+};
 
 /// The pairs held by the cache, sorted.
 std::vector<UidPair> cachedPairs(const btOverlappingPairCache& cache);
