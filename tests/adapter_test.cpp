@@ -529,7 +529,11 @@ TEST(IncrementalSearch, FewMovedBoxesGiveTheExactPairsLikeAFullSearch) {
             // Meaningful: pairs existed, and both kinds of search ran many times.
             EXPECT_GT(pairsSeen, 150u * 20);
             EXPECT_GT(adapter->stats().incrementalSearches, 100u);
-            EXPECT_LT(adapter->stats().incrementalSearches, 140u);
+            if (adapter->coreTracksOverlaps()) {
+                EXPECT_EQ(adapter->stats().fullSearches, 0u);  // the core's changes, every frame
+            } else {
+                EXPECT_LT(adapter->stats().incrementalSearches, 140u);
+            }
         }
 }
 
@@ -619,7 +623,7 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
             // Meaningful: the lattice's neighbours overlap now and then, and queries hit.
             EXPECT_GT(overlapsSeen, 120u * 50);
             EXPECT_GT(queryHits, 120u);
-            if (margin == 0) {
+            if (margin == 0 || adapter->coreTracksOverlaps()) {
                 EXPECT_EQ(stats.movesInsideFatBoxes, 0u);
                 EXPECT_EQ(stats.candidatePairs, stats.overlappingPairs);
             } else {

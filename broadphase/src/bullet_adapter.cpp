@@ -103,13 +103,7 @@ BroadphaseAdapter::~BroadphaseAdapter() {
 }
 
 const char* BroadphaseAdapter::rejectReason(const btVector3& aabbMin, const btVector3& aabbMax) {
-    // Fast path for every setAabb: finite and ordered (NaN fails every comparison).
-    constexpr btScalar kMax = std::numeric_limits<btScalar>::max();
-    bool good = true;
-    for (int axis = 0; axis < 3; ++axis) {
-        good &= aabbMin[axis] <= aabbMax[axis] && aabbMin[axis] >= -kMax && aabbMax[axis] <= kMax;
-    }
-    if (good) {
+    if (goodBox(aabbMin, aabbMax)) {
         return "";
     }
     for (int axis = 0; axis < 3; ++axis) {
@@ -201,16 +195,10 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
     return proxy;
 }
 
-BroadphaseAdapter::Proxy* BroadphaseAdapter::checkedProxy(btBroadphaseProxy* proxy,
-                                                          const char* operation) const {
-    Proxy* ours = static_cast<Proxy*>(proxy);
-    if (proxy == nullptr || ours->slot >= boxes_.size() || proxyOf(ours->slot) != ours ||
-        (state_[ours->slot] != SlotState::Live && state_[ours->slot] != SlotState::Parked)) {
-        throw std::invalid_argument("kolize " + name_ + ": " + operation +
-                                    " called with a proxy this broadphase does not own (or one "
-                                    "already destroyed)");
-    }
-    return ours;
+void BroadphaseAdapter::throwForeignProxy(const char* operation) const {
+    throw std::invalid_argument("kolize " + name_ + ": " + operation +
+                                " called with a proxy this broadphase does not own (or one "
+                                "already destroyed)");
 }
 
 bool BroadphaseAdapter::cacheHoldsOnlyOurs() const {
@@ -239,15 +227,16 @@ void BroadphaseAdapter::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dis
     // While this runs, callbacks of the pair cache may destroy other proxies: their pairs
     // are then erased at the end, so that this walk over the slot's pairs stays valid.
     ++deferErasures_;
-    const std::vector<std::uint32_t>& own = pairs_.pairsOf(slot);
+    std::vector<std::uint32_t> own;
+    pairs_.appendPairsOf(slot, own);
     if (cacheHoldsOnlyOurs()) {
-        for (std::size_t i = 0; i < own.size(); ++i) {
-            uncache(own[i], dispatcher);
+        for (std::uint32_t at : own) {
+            uncache(at, dispatcher);
         }
     } else {
         // Someone else's pairs may name this proxy too: only the cache can find them all.
-        for (std::size_t i = 0; i < own.size(); ++i) {
-            forget(own[i]);
+        for (std::uint32_t at : own) {
+            forget(at);
         }
         pairCache_->removeOverlappingPairsContainingProxy(ours, dispatcher);
     }
@@ -289,8 +278,7 @@ void BroadphaseAdapter::erasePairs(std::vector<std::uint32_t>& doomed) {
 
 void BroadphaseAdapter::releasePendingSlots() {
     for (ObjectId slot : pendingFree_) {
-        const std::vector<std::uint32_t>& own = pairs_.pairsOf(slot);  // all Apart by now
-        doomed_.assign(own.begin(), own.end());
+        pairs_.appendPairsOf(slot, doomed_);  // all Apart by now
         erasePairs(doomed_);
         state_[slot] = SlotState::Free;
         freeSlots_.push_back(slot);
@@ -302,9 +290,8 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
                                 const btVector3& aabbMax, btDispatcher* /*dispatcher*/) {
     Proxy* ours = checkedProxy(proxy, "setAabb");
     const ObjectId slot = ours->slot;
-    const char* reason = rejectReason(aabbMin, aabbMax);
-    if (*reason != '\0') {
-        reportBadAabb("setAabb", *ours, aabbMin, aabbMax, reason);
+    if (!goodBox(aabbMin, aabbMax)) {
+        reportBadAabb("setAabb", *ours, aabbMin, aabbMax, rejectReason(aabbMin, aabbMax));
         return;
     }
     const Box box = toBox(aabbMin, aabbMax);
@@ -314,6 +301,15 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
+        if (coreTracksOverlaps_) {
+            // The core finds the changed pairs itself: no fat box, no certificate.
+            boxes_[slot] = box;
+            fat_[slot] = box;
+            coreUpdate(slot, box);
+            ++counters_.coreUpdates;
+            trackedBoxesChanged_ = true;
+            return;
+        }
         travel_[slot] = (travel_[slot] + motion(boxes_[slot], box)) * kUp;
         if (contains(fat_[slot], box)) {
             // The core box still holds it: no new candidates. Its pairs need a look only
@@ -343,7 +339,7 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
 }
 
 BroadphaseAdapter::Box BroadphaseAdapter::fatBox(const Box& box, const Box& previous) const {
-    if (settings_.fatMargin == 0) {
+    if (settings_.fatMargin == 0 || coreTracksOverlaps_) {
         return box;
     }
     btScalar extent = 0, magnitude = 0, moved = 0;
@@ -428,6 +424,7 @@ std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery() {
 
 bool BroadphaseAdapter::beginPairs() {
     searching_ = true;
+    trackedBoxesChanged_ = false;
     if (++stamp_ == 0) {  // wrapped: no pair may look tested in this frame
         for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
             pairs_[at].stamp = 0;
@@ -474,6 +471,10 @@ void BroadphaseAdapter::checkCacheForLostPairs() {
         --cached_;
         --overlapping_;
         ++counters_.pairsRestored;
+        if (coreTracksOverlaps_) {
+            coreChanges_.emplace_back(pair.object[0], pair.object[1]);
+            continue;
+        }
         for (int side = 0; side < 2; ++side) {
             const ObjectId id = pair.object[side];
             pairs_.setTrigger(at, side, -HUGE_VAL);
@@ -489,14 +490,17 @@ void BroadphaseAdapter::dropLeftCandidates(ObjectId id, btDispatcher* dispatcher
     const Box& box = fat_[id];
     // Uncaching calls back into Bullet, whose callbacks may destroy proxies: collect first,
     // erase after.
-    ++deferErasures_;
-    const std::vector<std::uint32_t>& own = pairs_.pairsOf(id);
-    for (std::size_t i = 0; i < own.size(); ++i) {
-        const std::uint32_t at = own[i];
+    pairs_.forEachOf(id, [&](std::uint32_t at) {
         if (!overlaps(box, fat_[pairs_[at].other(id)])) {
-            uncache(at, dispatcher);
             doomed_.push_back(at);
         }
+    });
+    if (doomed_.empty()) {
+        return;
+    }
+    ++deferErasures_;
+    for (std::uint32_t at : doomed_) {
+        uncache(at, dispatcher);
     }
     --deferErasures_;
     erasePairs(doomed_);
@@ -579,7 +583,7 @@ void BroadphaseAdapter::lookAtDuePairs(ObjectId id, btDispatcher* dispatcher, bo
     // The heap's first pair is the one whose trigger the object passed first; a look sets
     // the triggers at or above the odometer, so the loop ends.
     for (std::uint32_t at = pairs_.firstDue(id); at != PairStore::kNone; at = pairs_.firstDue(id)) {
-        if (!(pairs_[at].trigger[pairs_[at].sideOf(id)] < travel_[id])) {
+        if (!(pairs_.trigger(at, pairs_[at].sideOf(id)) < travel_[id])) {
             break;
         }
         lookAtPair(at, dispatcher, retestFilter);
@@ -652,6 +656,62 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, bool full, std::si
     counters_.fullSearches += full ? 1 : 0;
     ++counters_.frames;
     counters_.candidatesLastFrame = candidates;
+    counters_.pairsTestedLastFrame = testedThisFrame_;
+    counters_.objectsLookedAtLastFrame = processing_.size();
+}
+
+void BroadphaseAdapter::finishTrackedPairs(btDispatcher* dispatcher) {
+    const bool everyFrame = settings_.filters == FilterEvaluation::EveryFrame;
+    testedThisFrame_ = 0;
+    // The store holds exactly the overlapping pairs: a changed pair is either overlapping
+    // (into the cache, filters permitting) or erased. No erasing until the end (callbacks
+    // may destroy proxies): indices hold.
+    ++deferErasures_;
+    for (const auto& change : coreChanges_) {
+        const ObjectId a = change.first, b = change.second;
+        if (state_[a] != SlotState::Live || state_[b] != SlotState::Live) {
+            continue;  // destroyed meanwhile: erased with its slot
+        }
+        ++testedThisFrame_;
+        if (overlaps(boxes_[a], boxes_[b])) {
+            bool inserted = false;
+            const std::uint32_t at = pairs_.findOrInsert(a, b, inserted, HUGE_VAL);
+            if (pairs_[at].status == PairStore::Status::Apart) {
+                ++overlapping_;
+                applyFilter(at, false, dispatcher);
+            }
+        } else {
+            const std::uint32_t at = pairs_.find(a, b);
+            if (at != PairStore::kNone && pairs_[at].stamp != stamp_) {
+                pairs_[at].stamp = stamp_;  // listed once
+                uncache(at, dispatcher);
+                doomed_.push_back(at);
+            }
+        }
+    }
+    coreChanges_.clear();
+    if (everyFrame) {
+        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+            const PairStore::Pair& pair = pairs_[at];
+            if (pair.status != PairStore::Status::Apart &&
+                state_[pair.object[0]] == SlotState::Live &&
+                state_[pair.object[1]] == SlotState::Live) {
+                applyFilter(at, true, dispatcher);
+            }
+        }
+    }
+    --deferErasures_;
+    erasePairs(doomed_);
+    for (const Moved& moved : processing_) {
+        frameKind_[moved.slot] = 0;
+    }
+    searching_ = false;
+    if (deferErasures_ == 0) {
+        releasePendingSlots();
+    }
+    ++counters_.incrementalSearches;
+    ++counters_.frames;
+    counters_.candidatesLastFrame = 0;
     counters_.pairsTestedLastFrame = testedThisFrame_;
     counters_.objectsLookedAtLastFrame = processing_.size();
 }
@@ -788,7 +848,8 @@ void BroadphaseAdapter::validate() const {
             }
             continue;
         }
-        const bool pending = movedKind_[a] != 0 || movedKind_[b] != 0;
+        const bool pending = movedKind_[a] != 0 || movedKind_[b] != 0 ||
+                             (coreTracksOverlaps_ && trackedBoxesChanged_);
         if (!overlaps(fat_[a], fat_[b]) && !pending) {
             fail("candidate pair whose core boxes do not overlap");
         }

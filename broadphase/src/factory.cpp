@@ -5,6 +5,7 @@
 #include <kolize/broadphase/cell_grid.h>
 #include <kolize/broadphase/range_tree.h>
 #include <kolize/broadphase/segment_tree_set.h>
+#include <kolize/broadphase/sweep_and_prune.h>
 
 #include <BulletCollision/BroadphaseCollision/btAxisSweep3.h>
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
@@ -31,8 +32,8 @@ void requireCapacity(std::string_view name, int maxProxies, int limit) {
 
 const std::vector<std::string>& broadphaseNames() {
     static const std::vector<std::string> names = {
-        "grid", "spatial-tree", "spatial-hash", "segment-trees", "range-tree", "brute-force",
-        "dbvt", "sap",          "sap-noray",    "sap32",         "simple"};
+        "grid",        "spatial-tree", "spatial-hash", "segment-trees", "range-tree", "sweep",
+        "brute-force", "dbvt",         "sap",          "sap-noray",     "sap32",      "simple"};
     return names;
 }
 
@@ -46,7 +47,8 @@ std::string broadphaseNameList() {
 
 bool isExactBroadphase(std::string_view name) {
     return name == "grid" || name == "spatial-tree" || name == "spatial-hash" ||
-           name == "segment-trees" || name == "range-tree" || name == "brute-force";
+           name == "segment-trees" || name == "range-tree" || name == "sweep" ||
+           name == "brute-force";
 }
 
 std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
@@ -80,6 +82,10 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
         tree.incremental = false;
         return std::make_unique<CoreBroadphase<RangeTree<3, btScalar>>>(std::string(name), settings,
                                                                         tree);
+    }
+    if (name == "sweep") {
+        return std::make_unique<CoreBroadphase<SweepAndPrune<3, btScalar>>>(std::string(name),
+                                                                            settings);
     }
     if (name == "dbvt") {
         return std::make_unique<btDbvtBroadphase>(settings.pairCache);

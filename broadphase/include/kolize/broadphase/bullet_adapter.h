@@ -40,8 +40,10 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kolize {
@@ -123,6 +125,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     void printStats() override;
 
     const std::string& name() const { return name_; }
+    /// True when the core tracks overlaps itself ("sweep"): exact boxes in the core, no fat
+    /// boxes, no pair certificates.
+    bool coreTracksOverlaps() const { return coreTracksOverlaps_; }
     AdapterStats stats() const;
     /// Checks proxy table, pair store and core invariants; throws std::logic_error.
     void validate() const;
@@ -206,6 +211,18 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     }
     void finishPairs(btDispatcher* dispatcher, bool full, std::size_t candidates);
 
+    /// For a core that tracks overlaps itself (kTracksOverlaps, "sweep"): exact boxes in
+    /// the core (no fat boxes, no certificates, the store holds exactly the overlapping
+    /// pairs). After beginPairs, noteCoreChange for every pair whose boxes the core says may
+    /// have started or stopped overlapping, then finishTrackedPairs tests only those.
+    void noteCoreChange(ObjectId a, ObjectId b) { coreChanges_.emplace_back(a, b); }
+    void finishTrackedPairs(btDispatcher* dispatcher);
+    /// Set by CoreBroadphase for a core that tracks overlaps.
+    bool coreTracksOverlaps_ = false;
+    /// A tracked core's box changed since the last pair search (validate() then cannot
+    /// expect the pairs to match the boxes).
+    bool trackedBoxesChanged_ = false;
+
   private:
     enum class SlotState : std::uint8_t { Free, Live, Parked, PendingFree };
     static constexpr unsigned kChunkBits = 8;
@@ -216,7 +233,25 @@ class BroadphaseAdapter : public btBroadphaseInterface {
         std::uint8_t kind;
     };
 
-    Proxy* checkedProxy(btBroadphaseProxy* proxy, const char* operation) const;
+    Proxy* checkedProxy(btBroadphaseProxy* proxy, const char* operation) const {
+        Proxy* ours = static_cast<Proxy*>(proxy);
+        if (proxy == nullptr || ours->slot >= state_.size() || proxyOf(ours->slot) != ours ||
+            (state_[ours->slot] != SlotState::Live && state_[ours->slot] != SlotState::Parked)) {
+            throwForeignProxy(operation);
+        }
+        return ours;
+    }
+    [[noreturn]] void throwForeignProxy(const char* operation) const;
+    /// Finite and ordered (NaN fails every comparison): the fast path of every setAabb.
+    static bool goodBox(const btVector3& aabbMin, const btVector3& aabbMax) {
+        constexpr btScalar kMax = std::numeric_limits<btScalar>::max();
+        bool good = true;
+        for (int axis = 0; axis < 3; ++axis) {
+            good &=
+                aabbMin[axis] <= aabbMax[axis] && aabbMin[axis] >= -kMax && aabbMax[axis] <= kMax;
+        }
+        return good;
+    }
     /// Erases the pairs of the slots destroyed while erasing had to wait, frees the slots.
     void releasePendingSlots();
     /// Returns an empty string for a valid box, else the reason.
@@ -294,7 +329,8 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// a setAabb whose travel passes the object's lowest trigger notes it, and only its due
     /// pairs are looked at.
     std::vector<double> travel_;
-    std::vector<std::uint32_t> doomed_;  ///< scratch: pairs to erase
+    std::vector<std::uint32_t> doomed_;                       ///< scratch: pairs to erase
+    std::vector<std::pair<ObjectId, ObjectId>> coreChanges_;  ///< from a core that tracks
     bool searching_ = false;
     /// > 0 while pair indices must hold (a walk that calls back into Bullet): destroyed
     /// proxies' pairs are erased afterwards.
@@ -318,10 +354,19 @@ class CoreBroadphase final : public BroadphaseAdapter {
                    const typename Core::Settings& coreSettings = {})
         : BroadphaseAdapter(std::move(name), settings),
           coreSettings_(coreSettings),
-          core_(coreSettings) {}
+          core_(coreSettings) {
+        coreTracksOverlaps_ = tracksOverlaps();
+    }
 
     void calculateOverlappingPairs(btDispatcher* dispatcher) override {
         if (busy()) {
+            return;
+        }
+        if constexpr (tracksOverlaps()) {
+            beginPairs();
+            core_.maintain();
+            core_.drainChanges([&](ObjectId a, ObjectId b) { noteCoreChange(a, b); });
+            finishTrackedPairs(dispatcher);
             return;
         }
         const bool full = beginPairs();
@@ -384,6 +429,16 @@ class CoreBroadphase final : public BroadphaseAdapter {
     const Core& core() const { return core_; }
 
   private:
+    template <class C>
+    static constexpr auto tracks(int) -> decltype(C::kTracksOverlaps, bool()) {
+        return C::kTracksOverlaps;
+    }
+    template <class C>
+    static constexpr bool tracks(long) {
+        return false;
+    }
+    static constexpr bool tracksOverlaps() { return tracks<Core>(0); }
+
     void coreInsert(ObjectId id, const Box& box) override { core_.insert(id, box); }
     void coreUpdate(ObjectId id, const Box& box) override { core_.update(id, box); }
     void coreRemove(ObjectId id) override { core_.remove(id); }

@@ -36,7 +36,6 @@ class PairStore {
     struct Pair {
         ObjectId object[2];       ///< object[0] < object[1]
         std::uint32_t heapAt[2];  ///< position in object[side]'s heap
-        double trigger[2];        ///< object[side]'s odometer reading that calls for a look
         double slack;             ///< certificate: < 0 not tested yet
         double travelled[2];      ///< certificate: the objects' odometers at the last test
         std::uint32_t stamp;      ///< frame mark of the adapter: a candidate in that frame
@@ -65,9 +64,10 @@ class PairStore {
         }
     }
 
-    /// Finds the pair or adds it (status Apart, untested, stamps 0, triggers -inf: it needs
-    /// a look); `inserted` tells which. Returns its index.
-    std::uint32_t findOrInsert(ObjectId a, ObjectId b, bool& inserted) {
+    /// Finds the pair or adds it (status Apart, untested, stamps 0, both triggers
+    /// `trigger`: by default -inf, it needs a look); `inserted` tells which. Returns its
+    /// index.
+    std::uint32_t findOrInsert(ObjectId a, ObjectId b, bool& inserted, double trigger = -HUGE_VAL) {
         if ((pairs_.size() + 1) * 4 > table_.size() * 3) {
             grow();
         }
@@ -85,7 +85,6 @@ class PairStore {
         Pair pair{};
         pair.object[0] = a < b ? a : b;
         pair.object[1] = a < b ? b : a;
-        pair.trigger[0] = pair.trigger[1] = -HUGE_VAL;
         pair.slack = -1;
         pair.status = Status::Apart;
         pairs_.push_back(pair);
@@ -94,10 +93,9 @@ class PairStore {
             if (id >= heaps_.size()) {
                 heaps_.resize(std::size_t(id) + 1);
             }
-            std::vector<std::uint32_t>& heap = heaps_[id];
-            pairs_[index].heapAt[side] = static_cast<std::uint32_t>(heap.size());
-            heap.push_back(index);
-            siftUp(id, pairs_[index].heapAt[side]);
+            std::vector<HeapEntry>& heap = heaps_[id];
+            heap.push_back(HeapEntry{trigger, index, std::uint32_t(side)});
+            siftUp(heap, heap.size() - 1);
         }
         inserted = true;
         return index;
@@ -115,41 +113,55 @@ class PairStore {
             pairs_[index] = pairs_[last];
             const Pair& moved = pairs_[index];
             for (int side = 0; side < 2; ++side) {
-                heaps_[moved.object[side]][moved.heapAt[side]] = index;
+                heaps_[moved.object[side]][moved.heapAt[side]].pair = index;
             }
             slotOf(keyOf(moved.object[0], moved.object[1])).index = index;
         }
         pairs_.pop_back();
     }
 
+    /// Object[side]'s trigger of pair `index`: its odometer reading that calls for a look.
+    double trigger(std::uint32_t index, int side) const {
+        const Pair& pair = pairs_[index];
+        return heaps_[pair.object[side]][pair.heapAt[side]].trigger;
+    }
     /// Sets object[side]'s trigger of pair `index` and restores its heap.
     void setTrigger(std::uint32_t index, int side, double trigger) {
-        Pair& pair = pairs_[index];
-        const double old = pair.trigger[side];
-        pair.trigger[side] = trigger;
+        const Pair& pair = pairs_[index];
+        std::vector<HeapEntry>& heap = heaps_[pair.object[side]];
+        const std::size_t at = pair.heapAt[side];
+        const double old = heap[at].trigger;
+        heap[at].trigger = trigger;
         if (trigger < old) {
-            siftUp(pair.object[side], pair.heapAt[side]);
+            siftUp(heap, at);
         } else if (trigger > old) {
-            siftDown(pair.object[side], pair.heapAt[side]);
+            siftDown(heap, at);
         }
     }
 
     /// The pair of `id` with the lowest trigger, or kNone.
     std::uint32_t firstDue(ObjectId id) const {
-        return id < heaps_.size() && !heaps_[id].empty() ? heaps_[id][0] : kNone;
+        return id < heaps_.size() && !heaps_[id].empty() ? heaps_[id][0].pair : kNone;
     }
     /// The lowest trigger of `id`'s pairs (+inf when it has none).
     double nextTrigger(ObjectId id) const {
-        const std::uint32_t at = firstDue(id);
-        return at == kNone ? HUGE_VAL : pairs_[at].trigger[pairs_[at].sideOf(id)];
+        return id < heaps_.size() && !heaps_[id].empty() ? heaps_[id][0].trigger : HUGE_VAL;
     }
 
-    /// The pairs of object `id` (heap order). Valid until the store changes.
-    const std::vector<std::uint32_t>& pairsOf(ObjectId id) const {
-        static const std::vector<std::uint32_t> none;
-        return id < heaps_.size() ? heaps_[id] : none;
+    /// Calls `visit(index)` for every pair of object `id`. `visit` must not change the store.
+    template <class Visit>
+    void forEachOf(ObjectId id, Visit&& visit) const {
+        if (id < heaps_.size()) {
+            for (const HeapEntry& entry : heaps_[id]) {
+                visit(entry.pair);
+            }
+        }
     }
-    std::size_t degree(ObjectId id) const { return pairsOf(id).size(); }
+    /// Appends the pairs of `id` to `out`.
+    void appendPairsOf(ObjectId id, std::vector<std::uint32_t>& out) const {
+        forEachOf(id, [&](std::uint32_t index) { out.push_back(index); });
+    }
+    std::size_t degree(ObjectId id) const { return id < heaps_.size() ? heaps_[id].size() : 0; }
 
     Pair& operator[](std::uint32_t index) { return pairs_[index]; }
     const Pair& operator[](std::uint32_t index) const { return pairs_[index]; }
@@ -160,15 +172,15 @@ class PairStore {
     void clear() {
         std::vector<Pair>().swap(pairs_);
         std::vector<Slot>().swap(table_);
-        std::vector<std::vector<std::uint32_t>>().swap(heaps_);
+        std::vector<std::vector<HeapEntry>>().swap(heaps_);
         mask_ = 0;
     }
 
     std::size_t memoryBytes() const {
         std::size_t bytes = pairs_.capacity() * sizeof(Pair) + table_.capacity() * sizeof(Slot) +
-                            heaps_.capacity() * sizeof(std::vector<std::uint32_t>);
-        for (const std::vector<std::uint32_t>& heap : heaps_) {
-            bytes += heap.capacity() * sizeof(std::uint32_t);
+                            heaps_.capacity() * sizeof(std::vector<HeapEntry>);
+        for (const std::vector<HeapEntry>& heap : heaps_) {
+            bytes += heap.capacity() * sizeof(HeapEntry);
         }
         return bytes;
     }
@@ -198,20 +210,19 @@ class PairStore {
         }
         std::size_t listed = 0;
         for (ObjectId id = 0; id < heaps_.size(); ++id) {
-            const std::vector<std::uint32_t>& heap = heaps_[id];
+            const std::vector<HeapEntry>& heap = heaps_[id];
             for (std::size_t at = 0; at < heap.size(); ++at) {
-                if (heap[at] >= pairs_.size()) {
+                if (heap[at].pair >= pairs_.size() || heap[at].side > 1) {
                     fail("heap of object " + std::to_string(id) + " leaves the array");
                 }
-                const Pair& pair = pairs_[heap[at]];
-                if (pair.object[0] != id && pair.object[1] != id) {
+                const Pair& pair = pairs_[heap[at].pair];
+                if (pair.object[heap[at].side] != id) {
                     fail("heap of object " + std::to_string(id) + " holds a foreign pair");
                 }
-                const int side = pair.sideOf(id);
-                if (pair.heapAt[side] != at) {
+                if (pair.heapAt[heap[at].side] != at) {
                     fail("broken back link in the heap of object " + std::to_string(id));
                 }
-                if (at > 0 && triggerAt(id, (at - 1) / 2) > pair.trigger[side]) {
+                if (at > 0 && heap[(at - 1) / 2].trigger > heap[at].trigger) {
                     fail("heap of object " + std::to_string(id) + " out of order");
                 }
                 ++listed;
@@ -256,59 +267,59 @@ class PairStore {
         return table_[at];
     }
 
-    double triggerAt(ObjectId id, std::size_t at) const {
-        const Pair& pair = pairs_[heaps_[id][at]];
-        return pair.trigger[pair.sideOf(id)];
+    /// One entry of an object's heap: the trigger inline, so that sifting reads only the
+    /// heap's own memory.
+    struct HeapEntry {
+        double trigger;
+        std::uint32_t pair;
+        std::uint32_t side;  ///< the object is pairs_[pair].object[side]
+    };
+
+    void place(std::vector<HeapEntry>& heap, std::size_t at, const HeapEntry& entry) {
+        heap[at] = entry;
+        pairs_[entry.pair].heapAt[entry.side] = static_cast<std::uint32_t>(at);
     }
-    void place(ObjectId id, std::size_t at, std::uint32_t index) {
-        heaps_[id][at] = index;
-        pairs_[index].heapAt[pairs_[index].sideOf(id)] = static_cast<std::uint32_t>(at);
-    }
-    void siftUp(ObjectId id, std::size_t at) {
-        std::vector<std::uint32_t>& heap = heaps_[id];
-        const std::uint32_t index = heap[at];
-        const double trigger = pairs_[index].trigger[pairs_[index].sideOf(id)];
+    void siftUp(std::vector<HeapEntry>& heap, std::size_t at) {
+        const HeapEntry entry = heap[at];
         while (at > 0) {
             const std::size_t parent = (at - 1) / 2;
-            if (!(triggerAt(id, parent) > trigger)) {
+            if (!(heap[parent].trigger > entry.trigger)) {
                 break;
             }
-            place(id, at, heap[parent]);
+            place(heap, at, heap[parent]);
             at = parent;
         }
-        place(id, at, index);
+        place(heap, at, entry);
     }
-    void siftDown(ObjectId id, std::size_t at) {
-        std::vector<std::uint32_t>& heap = heaps_[id];
-        const std::uint32_t index = heap[at];
-        const double trigger = pairs_[index].trigger[pairs_[index].sideOf(id)];
+    void siftDown(std::vector<HeapEntry>& heap, std::size_t at) {
+        const HeapEntry entry = heap[at];
         const std::size_t size = heap.size();
         for (;;) {
             std::size_t child = 2 * at + 1;
             if (child >= size) {
                 break;
             }
-            if (child + 1 < size && triggerAt(id, child + 1) < triggerAt(id, child)) {
+            if (child + 1 < size && heap[child + 1].trigger < heap[child].trigger) {
                 ++child;
             }
-            if (!(triggerAt(id, child) < trigger)) {
+            if (!(heap[child].trigger < entry.trigger)) {
                 break;
             }
-            place(id, at, heap[child]);
+            place(heap, at, heap[child]);
             at = child;
         }
-        place(id, at, index);
+        place(heap, at, entry);
     }
     void removeFromHeap(ObjectId id, std::size_t at) {
-        std::vector<std::uint32_t>& heap = heaps_[id];
-        const std::uint32_t last = heap.back();
+        std::vector<HeapEntry>& heap = heaps_[id];
+        const HeapEntry last = heap.back();
         heap.pop_back();
         if (at == heap.size()) {
             return;
         }
-        place(id, at, last);
-        siftUp(id, at);
-        siftDown(id, pairs_[last].heapAt[pairs_[last].sideOf(id)]);
+        place(heap, at, last);
+        siftUp(heap, at);
+        siftDown(heap, pairs_[last.pair].heapAt[last.side]);
     }
 
     void eraseSlot(std::uint64_t key) {
@@ -350,7 +361,7 @@ class PairStore {
 
     std::vector<Pair> pairs_;
     std::vector<Slot> table_;
-    std::vector<std::vector<std::uint32_t>> heaps_;
+    std::vector<std::vector<HeapEntry>> heaps_;
     std::size_t mask_ = 0;
 };
 
