@@ -24,7 +24,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +36,61 @@ namespace kolize {
 /// Settings of the sweep core (it has none that change its answers).
 struct SweepSettings {};
 
+namespace sweep_detail {
+
+/// One box endpoint in a sorted axis: its value, its object, and whether it is a max. The
+/// order: by value, and a min before a max of equal value (closed intervals: touching boxes
+/// overlap).
+template <class Scalar>
+struct Endpoint {
+    Scalar value_;
+    std::uint32_t code;  ///< id * 2 + (1 for a max)
+
+    static Endpoint make(Scalar value, ObjectId id, bool isMax) {
+        return Endpoint{value, id * 2 + (isMax ? 1u : 0u)};
+    }
+    Scalar value() const { return value_; }
+    void setValue(Scalar value) { value_ = value; }
+    ObjectId id() const { return code >> 1; }
+    bool isMax() const { return (code & 1) != 0; }
+    friend bool before(const Endpoint& a, const Endpoint& b) {
+        return a.value_ < b.value_ || (a.value_ == b.value_ && !a.isMax() && b.isMax());
+    }
+};
+
+/// For float, the order is one integer comparison: the value's bits mapped to an unsigned
+/// that sorts like the value (-0 taken as +0, so that they compare equal), then the max
+/// flag, then the id.
+template <>
+struct Endpoint<float> {
+    std::uint64_t key;
+
+    static std::uint32_t ordered(float value) {
+        std::uint32_t bits;
+        const float canonical = value == 0 ? 0.0f : value;
+        std::memcpy(&bits, &canonical, sizeof bits);
+        return (bits & 0x80000000u) != 0 ? ~bits : bits | 0x80000000u;
+    }
+    static Endpoint make(float value, ObjectId id, bool isMax) {
+        return Endpoint{(std::uint64_t(ordered(value)) << 32) | (isMax ? 0x80000000u : 0u) | id};
+    }
+    float value() const {
+        const std::uint32_t high = std::uint32_t(key >> 32);
+        const std::uint32_t bits = (high & 0x80000000u) != 0 ? high & 0x7fffffffu : ~high;
+        float out;
+        std::memcpy(&out, &bits, sizeof out);
+        return out;
+    }
+    void setValue(float value) {
+        key = (std::uint64_t(ordered(value)) << 32) | (key & 0xffffffffu);
+    }
+    ObjectId id() const { return ObjectId(key & 0x7fffffffu); }
+    bool isMax() const { return (key & 0x80000000u) != 0; }
+    friend bool before(const Endpoint& a, const Endpoint& b) { return a.key < b.key; }
+};
+
+}  // namespace sweep_detail
+
 template <int D, class Scalar>
 class SweepAndPrune {
   public:
@@ -41,67 +98,73 @@ class SweepAndPrune {
     using Settings = SweepSettings;
     /// The adapter takes changed pairs from drainChanges instead of querying for candidates.
     static constexpr bool kTracksOverlaps = true;
+    /// Ids are stored in 31 bits with the float layout.
+    static constexpr ObjectId kMaxId = 0x7fffffffu;
 
     explicit SweepAndPrune(const Settings& = {}) {}
 
     /// Adds object `id` (ids are dense; `id` must not be live); merged in at the next
-    /// maintain().
+    /// maintain(). Throws std::length_error past kMaxId.
     void insert(ObjectId id, const Box& box) {
-        if (id >= objects_.size()) {
-            objects_.resize(std::size_t(id) + 1);
+        if (id > kMaxId) {
+            throw std::length_error("kolize sweep: more than 2^31 objects");
         }
-        Object& object = objects_[id];
-        object.box = box;
-        object.state = State::Pending;
-        object.pendingAt = static_cast<std::uint32_t>(pending_.size());
+        if (id >= state_.size()) {
+            const std::size_t size = std::size_t(id) + 1;
+            state_.resize(size, State::Absent);
+            boxes_.resize(size);
+            at_.resize(size);
+            pendingAt_.resize(size, kSettled);
+        }
+        boxes_[id] = box;
+        state_[id] = State::Pending;
+        pendingAt_[id] = static_cast<std::uint32_t>(pending_.size());
         pending_.push_back(id);
         ++size_;
     }
 
     /// Moves object `id`: its endpoints swap their way to the new values.
     void update(ObjectId id, const Box& box) {
-        Object& object = objects_[id];
-        object.box = box;
-        if (object.state == State::Pending) {
+        boxes_[id] = box;
+        if (state_[id] == State::Pending) {
             return;
         }
         for (int axis = 0; axis < D; ++axis) {
             std::vector<Endpoint>& edges = axes_[axis];
-            const std::uint32_t low = object.at[axis][0], high = object.at[axis][1];
-            const Scalar oldLow = edges[low].value, oldHigh = edges[high].value;
-            if (oldLow == box.lo[axis] && oldHigh == box.hi[axis]) {
-                continue;
+            const std::uint32_t low = at_[id][2 * axis], high = at_[id][2 * axis + 1];
+            edges[low].setValue(box.lo[axis]);
+            edges[high].setValue(box.hi[axis]);
+            // Whether an endpoint has to move at all is one well-predicted test: jitter
+            // rarely passes a neighbour, while its direction would be a coin toss. A max
+            // moving up goes first and one moving down last, so that the min is never
+            // blocked by its own max (and neither ever passes the other).
+            if (high + 1 < edges.size() && before(edges[high + 1], edges[high])) {
+                sortUp(axis, high);
             }
-            edges[low].value = box.lo[axis];
-            edges[high].value = box.hi[axis];
-            // Growing first (only adds overlaps), then shrinking (only removes them).
-            if (box.lo[axis] < oldLow) {
+            if (low > 0 && before(edges[low], edges[low - 1])) {
                 sortDown(axis, low);
+            } else if (before(edges[low + 1], edges[low])) {
+                sortUp(axis, low);
             }
-            if (box.hi[axis] > oldHigh) {
-                sortUp(axis, object.at[axis][1]);
-            }
-            if (box.lo[axis] > oldLow) {
-                sortUp(axis, object.at[axis][0]);
-            }
-            if (box.hi[axis] < oldHigh) {
-                sortDown(axis, object.at[axis][1]);
+            const std::uint32_t max = at_[id][2 * axis + 1];
+            if (before(edges[max], edges[max - 1])) {
+                sortDown(axis, max);
             }
         }
     }
 
     /// Removes object `id`; its endpoints are compacted out at the next maintain().
     void remove(ObjectId id) {
-        Object& object = objects_[id];
-        if (object.state == State::Pending) {
-            const std::uint32_t at = object.pendingAt;
+        if (state_[id] == State::Pending) {
+            const std::uint32_t at = pendingAt_[id];
             pending_[at] = pending_.back();
-            objects_[pending_[at]].pendingAt = at;
+            pendingAt_[pending_[at]] = at;
             pending_.pop_back();
+            pendingAt_[id] = kSettled;
         } else {
             ++dead_;
         }
-        object.state = State::Dead;
+        state_[id] = State::Dead;
         --size_;
     }
 
@@ -121,8 +184,7 @@ class SweepAndPrune {
     template <class Sink>
     void drainChanges(Sink&& changed) {
         for (const Change& change : changes_) {
-            if (objects_[change.a].state == State::Sorted &&
-                objects_[change.b].state == State::Sorted) {
+            if (state_[change.a] == State::Sorted && state_[change.b] == State::Sorted) {
                 changed(change.a, change.b);
             }
         }
@@ -138,7 +200,7 @@ class SweepAndPrune {
         std::vector<ObjectId> active;
         for (const Endpoint& edge : axes_[0]) {
             const ObjectId id = edge.id();
-            if (objects_[id].state != State::Sorted) {
+            if (state_[id] != State::Sorted) {
                 continue;
             }
             if (edge.isMax()) {
@@ -161,10 +223,10 @@ class SweepAndPrune {
             visit(id);
         }
         const std::vector<Endpoint>& edges = axes_[0];
-        for (std::size_t at = 0; at < edges.size() && !(edges[at].value > box.hi[0]); ++at) {
+        for (std::size_t at = 0; at < edges.size() && !(edges[at].value() > box.hi[0]); ++at) {
             const ObjectId id = edges[at].id();
-            if (!edges[at].isMax() && objects_[id].state == State::Sorted &&
-                !(objects_[id].box.hi[0] < box.lo[0])) {
+            if (!edges[at].isMax() && state_[id] == State::Sorted &&
+                !(boxes_[id].hi[0] < box.lo[0])) {
                 visit(id);
             }
         }
@@ -173,8 +235,8 @@ class SweepAndPrune {
     /// Every live object (the adapter's exact test decides).
     template <class Visit>
     void queryRay(const Ray<D, Scalar>& /*ray*/, Visit&& visit) const {
-        for (ObjectId id = 0; id < objects_.size(); ++id) {
-            if (objects_[id].state == State::Sorted || objects_[id].state == State::Pending) {
+        for (ObjectId id = 0; id < state_.size(); ++id) {
+            if (state_[id] == State::Sorted || state_[id] == State::Pending) {
                 visit(id);
             }
         }
@@ -192,26 +254,25 @@ class SweepAndPrune {
             throw std::logic_error("SweepAndPrune: " + what);
         };
         std::size_t sorted = 0, pending = 0, dead = 0;
-        for (ObjectId id = 0; id < objects_.size(); ++id) {
-            const Object& object = objects_[id];
-            if (object.state == State::Sorted) {
+        for (ObjectId id = 0; id < state_.size(); ++id) {
+            if (state_[id] == State::Sorted) {
                 ++sorted;
                 for (int axis = 0; axis < D; ++axis) {
                     for (int end = 0; end < 2; ++end) {
-                        const std::uint32_t at = object.at[axis][end];
+                        const std::uint32_t at = at_[id][2 * axis + end];
                         if (at >= axes_[axis].size() || axes_[axis][at].id() != id ||
                             axes_[axis][at].isMax() != (end == 1)) {
                             fail("endpoint position of object " + std::to_string(id) + " wrong");
                         }
-                        const Scalar value = end == 0 ? object.box.lo[axis] : object.box.hi[axis];
-                        if (axes_[axis][at].value != value) {
+                        const Scalar value = end == 0 ? boxes_[id].lo[axis] : boxes_[id].hi[axis];
+                        if (!(axes_[axis][at].value() == value)) {
                             fail("endpoint value of object " + std::to_string(id) + " stale");
                         }
                     }
                 }
-            } else if (object.state == State::Pending) {
+            } else if (state_[id] == State::Pending) {
                 ++pending;
-                if (object.pendingAt >= pending_.size() || pending_[object.pendingAt] != id) {
+                if (pendingAt_[id] >= pending_.size() || pending_[pendingAt_[id]] != id) {
                     fail("pending list broken at object " + std::to_string(id));
                 }
             }
@@ -225,7 +286,7 @@ class SweepAndPrune {
             }
             std::size_t deadEdges = 0;
             for (const Endpoint& edge : edges) {
-                deadEdges += objects_[edge.id()].state == State::Sorted ? 0 : 1;
+                deadEdges += state_[edge.id()] == State::Sorted ? 0 : 1;
             }
             dead = deadEdges / 2;
             if (edges.size() != 2 * (sorted + dead)) {
@@ -238,10 +299,11 @@ class SweepAndPrune {
     }
 
     std::size_t memoryBytes() const {
-        std::size_t bytes = objects_.capacity() * sizeof(Object) +
+        std::size_t bytes = state_.capacity() + boxes_.capacity() * sizeof(Box) +
+                            at_.capacity() * sizeof(Positions) +
                             changes_.capacity() * sizeof(Change) +
-                            (pending_.capacity() + active_.capacity() + newActive_.capacity() +
-                             activeAt_.capacity()) *
+                            (pendingAt_.capacity() + pending_.capacity() + active_.capacity() +
+                             newActive_.capacity() + activeAt_.capacity()) *
                                 sizeof(std::uint32_t) +
                             scratch_.capacity() * sizeof(Endpoint);
         for (const std::vector<Endpoint>& edges : axes_) {
@@ -251,36 +313,24 @@ class SweepAndPrune {
     }
 
   private:
+    using Endpoint = sweep_detail::Endpoint<Scalar>;
+    /// Per object: the positions of its min and max on every axis (2 * axis + 0 / 1), kept
+    /// apart from the boxes so that swaps touch dense memory.
+    using Positions = std::array<std::uint32_t, 2 * D>;
     enum class State : std::uint8_t { Absent, Pending, Sorted, Dead };
-    struct Endpoint {
-        Scalar value;
-        std::uint32_t code;  ///< id * 2 + (1 for a max)
-        ObjectId id() const { return code >> 1; }
-        bool isMax() const { return (code & 1) != 0; }
-    };
-    struct Object {
-        Box box{};
-        std::array<std::array<std::uint32_t, 2>, D> at{};  ///< positions of min and max
-        std::uint32_t pendingAt = 0;
-        State state = State::Absent;
-    };
     struct Change {
         ObjectId a, b;
     };
-
-    /// The endpoints' order: by value, a min before a max of equal value.
-    static bool before(const Endpoint& a, const Endpoint& b) {
-        return a.value < b.value || (a.value == b.value && !a.isMax() && b.isMax());
-    }
+    static constexpr std::uint32_t kSettled = 0xffffffffu;
 
     /// Whether objects a and b overlap on every axis but `skip`, by the positions of their
     /// endpoints (the arrays' present order, which later swaps start from).
     bool overlapsOnOtherAxes(ObjectId a, ObjectId b, int skip) const {
-        const Object& first = objects_[a];
-        const Object& second = objects_[b];
+        const Positions& first = at_[a];
+        const Positions& second = at_[b];
         for (int axis = 0; axis < D; ++axis) {
-            if (axis != skip && (first.at[axis][1] < second.at[axis][0] ||
-                                 second.at[axis][1] < first.at[axis][0])) {
+            if (axis != skip && (first[2 * axis + 1] < second[2 * axis] ||
+                                 second[2 * axis + 1] < first[2 * axis])) {
                 return false;
             }
         }
@@ -292,18 +342,17 @@ class SweepAndPrune {
     void swapUp(int axis, std::uint32_t at) {
         std::vector<Endpoint>& edges = axes_[axis];
         const Endpoint lower = edges[at], upper = edges[at + 1];
+        const ObjectId lowerId = lower.id(), upperId = upper.id();
         ++swaps_;
-        if (lower.isMax() != upper.isMax() && lower.id() != upper.id() &&
-            objects_[lower.id()].state == State::Sorted &&
-            objects_[upper.id()].state == State::Sorted &&
-            overlapsOnOtherAxes(lower.id(), upper.id(), axis)) {
-            changes_.push_back(Change{lower.id(), upper.id()});
+        if (lower.isMax() != upper.isMax() && state_[lowerId] == State::Sorted &&
+            state_[upperId] == State::Sorted && overlapsOnOtherAxes(lowerId, upperId, axis)) {
+            changes_.push_back(Change{lowerId, upperId});
             ++changesRecorded_;
         }
         edges[at] = upper;
         edges[at + 1] = lower;
-        objects_[upper.id()].at[axis][upper.isMax() ? 1 : 0] = at;
-        objects_[lower.id()].at[axis][lower.isMax() ? 1 : 0] = at + 1;
+        at_[upperId][2 * axis + (upper.isMax() ? 1 : 0)] = at;
+        at_[lowerId][2 * axis + (lower.isMax() ? 1 : 0)] = at + 1;
     }
     void sortDown(int axis, std::uint32_t at) {
         const std::vector<Endpoint>& edges = axes_[axis];
@@ -325,16 +374,16 @@ class SweepAndPrune {
             std::vector<Endpoint>& edges = axes_[axis];
             std::size_t kept = 0;
             for (const Endpoint& edge : edges) {
-                if (objects_[edge.id()].state == State::Sorted) {
+                if (state_[edge.id()] == State::Sorted) {
                     edges[kept++] = edge;
                 }
             }
             edges.resize(kept);
             reindex(axis);
         }
-        for (Object& object : objects_) {
-            if (object.state == State::Dead) {
-                object.state = State::Absent;
+        for (State& state : state_) {
+            if (state == State::Dead) {
+                state = State::Absent;
             }
         }
         dead_ = 0;
@@ -343,7 +392,7 @@ class SweepAndPrune {
     void reindex(int axis) {
         const std::vector<Endpoint>& edges = axes_[axis];
         for (std::uint32_t at = 0; at < edges.size(); ++at) {
-            objects_[edges[at].id()].at[axis][edges[at].isMax() ? 1 : 0] = at;
+            at_[edges[at].id()][2 * axis + (edges[at].isMax() ? 1 : 0)] = at;
         }
     }
 
@@ -353,31 +402,33 @@ class SweepAndPrune {
     /// objects open.
     void merge() {
         for (ObjectId id : pending_) {
-            objects_[id].state = State::Sorted;
+            state_[id] = State::Sorted;
         }
         for (int axis = 0; axis < D; ++axis) {
             scratch_.clear();
             for (ObjectId id : pending_) {
-                scratch_.push_back(Endpoint{objects_[id].box.lo[axis], id * 2});
-                scratch_.push_back(Endpoint{objects_[id].box.hi[axis], id * 2 + 1});
+                scratch_.push_back(Endpoint::make(boxes_[id].lo[axis], id, false));
+                scratch_.push_back(Endpoint::make(boxes_[id].hi[axis], id, true));
             }
-            std::sort(scratch_.begin(), scratch_.end(), before);
+            std::sort(scratch_.begin(), scratch_.end(),
+                      [](const Endpoint& a, const Endpoint& b) { return before(a, b); });
             std::vector<Endpoint>& edges = axes_[axis];
             const std::size_t old = edges.size();
             edges.insert(edges.end(), scratch_.begin(), scratch_.end());
-            std::inplace_merge(edges.begin(), edges.begin() + long(old), edges.end(), before);
+            std::inplace_merge(edges.begin(), edges.begin() + long(old), edges.end(),
+                               [](const Endpoint& a, const Endpoint& b) { return before(a, b); });
             reindex(axis);
         }
         const int axis = sweepAxis();
         active_.clear();
         newActive_.clear();
-        if (activeAt_.size() < objects_.size()) {
-            activeAt_.resize(objects_.size());
+        if (activeAt_.size() < state_.size()) {
+            activeAt_.resize(state_.size());
         }
-        auto isNew = [&](ObjectId id) { return objects_[id].pendingAt != kSettled; };
+        auto isNew = [&](ObjectId id) { return pendingAt_[id] != kSettled; };
         for (const Endpoint& edge : axes_[axis]) {
             const ObjectId id = edge.id();
-            if (objects_[id].state != State::Sorted) {
+            if (state_[id] != State::Sorted) {
                 continue;
             }
             std::vector<ObjectId>& list = isNew(id) ? newActive_ : active_;
@@ -404,7 +455,7 @@ class SweepAndPrune {
             list.push_back(id);
         }
         for (ObjectId id : pending_) {
-            objects_[id].pendingAt = kSettled;
+            pendingAt_[id] = kSettled;
         }
         pending_.clear();
     }
@@ -418,10 +469,10 @@ class SweepAndPrune {
             if (edges.empty()) {
                 return 0;
             }
-            const double spread = double(edges.back().value) - double(edges.front().value);
+            const double spread = double(edges.back().value()) - double(edges.front().value());
             double extents = 0;
             for (const Endpoint& edge : edges) {
-                extents += edge.isMax() ? double(edge.value) : -double(edge.value);
+                extents += edge.isMax() ? double(edge.value()) : -double(edge.value());
             }
             const double crowding = spread > 0 ? extents / spread : HUGE_VAL;
             if (crowding < bestCrowding) {
@@ -432,10 +483,11 @@ class SweepAndPrune {
         return best;
     }
 
-    static constexpr std::uint32_t kSettled = 0xffffffffu;
-
     std::array<std::vector<Endpoint>, D> axes_;
-    std::vector<Object> objects_;
+    std::vector<State> state_;
+    std::vector<Box> boxes_;
+    std::vector<Positions> at_;
+    std::vector<std::uint32_t> pendingAt_;  ///< index in pending_, or kSettled
     std::vector<ObjectId> pending_;
     std::vector<Change> changes_;
     std::vector<Endpoint> scratch_;
