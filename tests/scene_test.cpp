@@ -60,7 +60,8 @@ TEST(SceneRegistry, HoldsTheNamedScenesWithFilledInfo) {
         EXPECT_FALSE(info.pipelineWhy.empty()) << info.name;
         EXPECT_GT(info.defaultObjects, 0) << info.name;
         EXPECT_GT(info.worldHalfExtent, 0) << info.name;
-        const std::set<std::string> groups = {"thesis", "bullet", "mesh", "extreme", "stiff"};
+        const std::set<std::string> groups = {"thesis",  "bullet", "mesh",
+                                              "extreme", "stiff",  "bullet-benchmark"};
         EXPECT_EQ(groups.count(info.group), 1u) << info.name << ": group " << info.group;
     }
     for (const char* name : {"pyramid", "mixed-terrain", "mixed-plane", "mixed-rays", "offset-1e4",
@@ -68,6 +69,15 @@ TEST(SceneRegistry, HoldsTheNamedScenesWithFilledInfo) {
                              "tall-stack", "mass-ratio-stack"}) {
         EXPECT_EQ(names.count(name), 1u) << name;
     }
+    for (const char* name :
+         {"bench-3000-boxes", "bench-1000-stack", "bench-ragdolls", "bench-convex-stack",
+          "bench-prim-mesh", "bench-convex-mesh", "bench-raycast", "bench-convex-pack"}) {
+        EXPECT_EQ(names.count(name), 1u) << name;
+    }
+    EXPECT_TRUE(findScene("bench-raycast").needs.rays);
+    EXPECT_TRUE(findScene("bench-prim-mesh").needs.meshes);
+    EXPECT_FALSE(findScene("bench-3000-boxes").needs.meshes);
+    EXPECT_EQ(findScene("bench-ragdolls").defaultObjects, 1496);
 #ifdef KOLIZE_WITH_ASSIMP
     EXPECT_EQ(names.count("meshes"), 1u);
 #else
@@ -120,7 +130,10 @@ TEST_P(EveryScene, PairsMatchTheTruthEveryFrame) {
         auto scene = build(info.name, broadphase, options);
         EXPECT_GT(scene->movingObjects(), 0);
         std::size_t framesWithPairs = 0;
-        for (int frame = 0; frame < (thesis ? 4 : 40); ++frame) {
+        // The landscape scenes' bodies start 8 m or more above it: 2.5 s to land.
+        const bool landscape = info.name == "bench-prim-mesh" || info.name == "bench-convex-mesh" ||
+                               info.name == "bench-raycast";
+        for (int frame = 0; frame < (thesis ? 4 : landscape ? 150 : 40); ++frame) {
             scene->step();
             framesWithPairs += checkPairs(*scene, broadphase, frame) > 0 ? 1 : 0;
             ASSERT_EQ(scene->state().nonFinite, 0) << "frame " << frame;
@@ -162,8 +175,16 @@ bool sameBoxes(const std::vector<ProxyBox>& a, const std::vector<ProxyBox>& b) {
 
 TEST(SceneSeeds, SameSeedSameSceneOtherSeedOtherScene) {
     // Scenes without randomness: regular layouts.
-    const std::set<std::string> seedless = {"boxes", "boxes-plane", "pyramid", "tall-stack",
-                                            "mass-ratio-stack"};
+    const std::set<std::string> seedless = {"boxes",
+                                            "boxes-plane",
+                                            "pyramid",
+                                            "tall-stack",
+                                            "mass-ratio-stack",
+                                            "bench-3000-boxes",
+                                            "bench-1000-stack",
+                                            "bench-ragdolls",
+                                            "bench-convex-stack",
+                                            "bench-convex-pack"};
     for (const SceneInfo& info : sceneList()) {
         if (info.name == "meshes" && !assetsPresent()) {
             continue;

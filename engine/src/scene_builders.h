@@ -26,4 +26,8 @@ const std::vector<SceneEntry>& sceneEntries();
 /// and stiff cases).
 void addWorldScenes(std::vector<SceneEntry>& entries);
 
+/// Appends the scenes of Bullet's own benchmark (BenchmarkDemo), rebuilt from their
+/// description (bullet_benchmark_scenes.cpp).
+void addBulletBenchmarkScenes(std::vector<SceneEntry>& entries);
+
 }  // namespace kolize

@@ -60,6 +60,10 @@ WorldScene::WorldScene(SceneInfo info, std::unique_ptr<btBroadphaseInterface> br
 }
 
 WorldScene::~WorldScene() {
+    for (const std::unique_ptr<btTypedConstraint>& constraint : constraints_) {
+        world_->removeConstraint(constraint.get());
+    }
+    constraints_.clear();
     for (btRigidBody* body : bodies_) {
         world_->removeRigidBody(body);
         delete body->getMotionState();
@@ -114,6 +118,13 @@ void WorldScene::removeBody(btRigidBody* body) {
     bodies_.erase(at);
     delete body->getMotionState();
     delete body;
+}
+
+btTypedConstraint* WorldScene::addConstraint(btTypedConstraint* constraint,
+                                             bool disableCollisions) {
+    constraints_.emplace_back(constraint);
+    world_->addConstraint(constraint, disableCollisions);
+    return constraint;
 }
 
 void WorldScene::setContainer(const btVector3& min, const btVector3& max) {

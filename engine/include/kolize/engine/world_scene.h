@@ -21,6 +21,7 @@ class btRigidBody;
 class btCollisionDispatcher;
 class btDefaultCollisionConfiguration;
 class btSequentialImpulseConstraintSolver;
+class btTypedConstraint;
 
 namespace kolize {
 
@@ -87,6 +88,9 @@ class WorldScene : public Scene {
                          const btVector3& linearVelocity = btVector3(0, 0, 0));
     /// Removes one body from the world and deletes it.
     void removeBody(btRigidBody* body);
+    /// Adds a joint (owned; deleted before the bodies). `disableCollisions`: the two bodies
+    /// it links get no contact pair (btDiscreteDynamicsWorld::addConstraint's flag).
+    btTypedConstraint* addConstraint(btTypedConstraint* constraint, bool disableCollisions);
     /// Dynamic bodies whose centre leaves this box (relative to origin()) count as escaped
     /// (tunnelled through the ground or out of a bowl). Without a container none escape.
     void setContainer(const btVector3& min, const btVector3& max);
@@ -107,6 +111,7 @@ class WorldScene : public Scene {
     std::vector<std::unique_ptr<btStridingMeshInterface>> meshes_;  // before shapes_: outlives them
     std::vector<std::unique_ptr<btCollisionShape>> shapes_;
     std::vector<btRigidBody*> bodies_;
+    std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
     int dynamicBodies_ = 0;
     bool hasContainer_ = false;
     btVector3 containerMin_, containerMax_;
