@@ -13,6 +13,11 @@ function(kolize_add_layer target export_name)
         $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
     target_compile_features(${target} PUBLIC cxx_std_17)
     target_link_libraries(${target} PUBLIC ${ARG_LINK} PRIVATE $<BUILD_INTERFACE:kolize_warnings>)
+    if(KOLIZE_SANITIZE)
+        # Static libraries built with the sanitizers need them at the consumer's link too;
+        # the installed package carries the flag.
+        target_link_options(${target} INTERFACE -fsanitize=address,undefined)
+    endif()
     install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
     set_property(GLOBAL APPEND PROPERTY KOLIZE_INSTALL_TARGETS ${target})
 endfunction()

@@ -11,6 +11,7 @@
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
 #include <BulletCollision/BroadphaseCollision/btSimpleBroadphase.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -25,6 +26,19 @@ void requireCapacity(std::string_view name, int maxProxies, int limit) {
         throw std::invalid_argument("kolize: broadphase '" + std::string(name) +
                                     "' needs settings.maxProxies in [2, " + std::to_string(limit) +
                                     "], got " + std::to_string(maxProxies));
+    }
+}
+
+void requireWorldBounds(std::string_view name, const BroadphaseSettings& settings) {
+    for (int axis = 0; axis < 3; ++axis) {
+        const btScalar lo = settings.worldMin[axis], hi = settings.worldMax[axis];
+        if (!(std::isfinite(lo) && std::isfinite(hi) && lo < hi)) {
+            throw std::invalid_argument(
+                "kolize: broadphase '" + std::string(name) +
+                "' quantises to settings.worldMin..worldMax, which must be finite with min < max "
+                "on every axis; axis " +
+                std::to_string(axis) + " is " + std::to_string(lo) + ".." + std::to_string(hi));
+        }
     }
 }
 
@@ -92,12 +106,14 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
     }
     if (name == "sap" || name == "sap-noray") {
         requireCapacity(name, settings.maxProxies, kSap16MaxProxies);
+        requireWorldBounds(name, settings);
         return std::make_unique<btAxisSweep3>(
             settings.worldMin, settings.worldMax, static_cast<unsigned short>(settings.maxProxies),
             settings.pairCache, /*disableRaycastAccelerator=*/name == "sap-noray");
     }
     if (name == "sap32") {
         requireCapacity(name, settings.maxProxies, 0x7ffffffe);
+        requireWorldBounds(name, settings);
         return std::make_unique<bt32BitAxisSweep3>(settings.worldMin, settings.worldMax,
                                                    static_cast<unsigned>(settings.maxProxies),
                                                    settings.pairCache);

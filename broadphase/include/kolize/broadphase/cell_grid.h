@@ -34,6 +34,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -61,17 +62,26 @@ class CellGrid {
 
     /// Throws std::invalid_argument for settings that cannot work.
     explicit CellGrid(const Settings& settings = {}) : settings_(settings) {
-        if (!(settings.cellSize >= 0) || !(settings.sizeFactor > 0) ||
-            !(settings.maxCellsPerObject >= 1) || !(settings.rechooseFactor >= 0) ||
-            !(settings.cellsPerObject > 0) || !(settings.maxCells >= 1) ||
-            !(settings.maxCells <= 2147483648.0) || settings.cellsPerAxis < 0 ||
-            !std::isfinite(settings.cellSize)) {
-            throw std::invalid_argument(
-                "CellGridSettings: cellSize must be finite and >= 0, sizeFactor, "
-                "cellsPerObject > 0, maxCellsPerObject >= 1, maxCells in [1, 2^31], "
-                "rechooseFactor, "
-                "cellsPerAxis >= 0");
-        }
+        auto require = [](bool good, const std::string& what) {
+            if (!good) {
+                throw std::invalid_argument("kolize CellGridSettings: " + what);
+            }
+        };
+        require(settings.cellSize >= 0 && std::isfinite(settings.cellSize),
+                "cellSize must be finite and >= 0 (0: automatic), got " +
+                    std::to_string(settings.cellSize));
+        require(settings.sizeFactor > 0,
+                "sizeFactor must be > 0, got " + std::to_string(settings.sizeFactor));
+        require(settings.maxCellsPerObject >= 1, "maxCellsPerObject must be >= 1, got " +
+                                                     std::to_string(settings.maxCellsPerObject));
+        require(settings.rechooseFactor >= 0, "rechooseFactor must be >= 0 (0: never), got " +
+                                                  std::to_string(settings.rechooseFactor));
+        require(settings.cellsPerObject > 0,
+                "cellsPerObject must be > 0, got " + std::to_string(settings.cellsPerObject));
+        require(settings.maxCells >= 1 && settings.maxCells <= 2147483648.0,
+                "maxCells must be in [1, 2^31], got " + std::to_string(settings.maxCells));
+        require(settings.cellsPerAxis >= 0, "cellsPerAxis must be >= 0 (0: automatic), got " +
+                                                std::to_string(settings.cellsPerAxis));
     }
 
     void insert(ObjectId id, const Box& box) {
@@ -185,7 +195,11 @@ class CellGrid {
     /// Objects in the cells along the ray (and around it, by the ray's swept box), and
     /// every overflow object. The ray is clipped to the bounds of the binned objects and
     /// walked in steps of at most one cell per axis; each step visits the cells of the
-    /// step's box that the previous step did not.
+    /// step's box that the previous step did not. The walk is widened by a bound on the
+    /// rounding of Bullet's slab test in Scalar (which accepts boxes a few roundings of the
+    /// coordinates off the exact ray: metres, for a ray starting 1e8 out in float); when
+    /// that makes the walk dearer than the live cells, or the ray is not finite, the live
+    /// cells within the clipped bounds are visited instead.
     template <class Visit>
     void queryRay(const Ray<D, Scalar>& ray, Visit&& visit) const {
         if (!chosen_) {
@@ -201,18 +215,37 @@ class CellGrid {
         if (contentDirty_) {
             recomputeContent();
         }
-        // Bounds of what a hit must touch: binned boxes, widened by the swept box.
-        std::array<double, D> origin{}, direction{}, lo{}, hi{};
-        double t0 = 0, t1 = double(ray.lambdaMax);
+        const double lambda = double(ray.lambdaMax);
+        const double roundings = 8 * double(std::numeric_limits<Scalar>::epsilon()) + 0x1p-46;
+        std::array<double, D> origin{}, direction{}, lo{}, hi{}, pad{};
+        bool finite = std::isfinite(lambda) && lambda >= 0;
         for (int axis = 0; axis < D; ++axis) {
             origin[axis] = double(ray.origin[axis]);
             const double inverse = double(ray.inverseDirection[axis]);
-            direction[axis] = std::fabs(inverse) >= 1e17 ? 0.0 : 1.0 / inverse;
-            lo[axis] = contentLo_[axis] - double(ray.expandHi[axis]);
-            hi[axis] = contentHi_[axis] - double(ray.expandLo[axis]);
-            const double pad = 1e-6 * (std::fabs(lo[axis]) + std::fabs(hi[axis]) + cellSize_);
-            lo[axis] -= pad;
-            hi[axis] += pad;
+            const double expandLo = double(ray.expandLo[axis]);
+            const double expandHi = double(ray.expandHi[axis]);
+            // Bullet marks an axis the ray does not move along with a huge inverse.
+            const bool still = !(std::fabs(inverse) < 1e17);
+            direction[axis] = still ? 0.0 : 1.0 / inverse;
+            const double magnitude =
+                std::fabs(origin[axis]) + std::fabs(direction[axis]) * lambda +
+                std::max(std::fabs(contentLo_[axis]), std::fabs(contentHi_[axis])) +
+                std::fabs(expandLo) + std::fabs(expandHi);
+            pad[axis] =
+                roundings * magnitude + 1e-9 * cellSize_ +
+                (still && std::isfinite(inverse) && inverse != 0 ? lambda / std::fabs(inverse) : 0);
+            lo[axis] = contentLo_[axis] - expandHi - pad[axis];
+            hi[axis] = contentHi_[axis] - expandLo + pad[axis];
+            finite = finite && std::isfinite(origin[axis]) && std::isfinite(direction[axis]) &&
+                     std::isfinite(pad[axis]) && std::isfinite(lo[axis]) &&
+                     std::isfinite(hi[axis]) && !(still && std::isnan(inverse));
+        }
+        if (!finite) {
+            visitAllBinned(visit);
+            return;
+        }
+        double t0 = 0, t1 = lambda;
+        for (int axis = 0; axis < D; ++axis) {
             if (direction[axis] == 0) {
                 if (origin[axis] < lo[axis] || origin[axis] > hi[axis]) {
                     return;
@@ -230,22 +263,34 @@ class CellGrid {
         if (!(t0 <= t1)) {
             return;
         }
-        double fastest = 0;
+        // The box of the clipped segment, widened: what the walk, or the fallback, covers.
+        auto segmentBox = [&](double a, double b) {
+            Box part;
+            for (int axis = 0; axis < D; ++axis) {
+                const double pa = origin[axis] + a * direction[axis];
+                const double pb = origin[axis] + b * direction[axis];
+                part.lo[axis] =
+                    roundedDown(std::min(pa, pb) + double(ray.expandLo[axis]) - pad[axis]);
+                part.hi[axis] =
+                    roundedUp(std::max(pa, pb) + double(ray.expandHi[axis]) + pad[axis]);
+            }
+            return part;
+        };
+        double fastest = 0, cellsPerStep = 1;
         for (int axis = 0; axis < D; ++axis) {
             fastest = std::max(fastest, std::fabs(direction[axis]));
         }
         const double stepLength = fastest > 0 ? 0.5 * cellSize_ / fastest : (t1 - t0) + 1;
-        const std::size_t steps =
-            static_cast<std::size_t>(std::min(1e9, std::ceil((t1 - t0) / stepLength))) + 1;
-        if (double(steps) > 4.0 * double(index_.liveCount()) + 64) {
-            // A long walk through mostly empty space: cheaper to look at every live cell.
-            Box all;
-            for (int axis = 0; axis < D; ++axis) {
-                all.lo[axis] = Scalar(lo[axis]);
-                all.hi[axis] = Scalar(hi[axis]);
-            }
-            const Range range = rangeOf(all);
-            visitCells(range, visit);
+        for (int axis = 0; axis < D; ++axis) {
+            const double width = std::fabs(direction[axis]) * stepLength + 2 * pad[axis] +
+                                 double(ray.expandHi[axis]) - double(ray.expandLo[axis]);
+            cellsPerStep *= width / cellSize_ + 2;
+        }
+        const double steps = std::ceil((t1 - t0) / stepLength) + 1;
+        if (!(steps * cellsPerStep <= 4.0 * double(index_.liveCount()) + 64)) {
+            // A long walk through mostly empty space, or a wide one: the live cells in the
+            // segment's bounds cost less.
+            visitCells(rangeOf(segmentBox(t0, t1)), visit);
             return;
         }
         std::vector<std::uint32_t>& seen = seenStamp_;
@@ -256,21 +301,12 @@ class CellGrid {
         }
         Range previous{};
         bool havePrevious = false;
-        for (std::size_t step = 0; step < steps; ++step) {
+        for (std::size_t step = 0; step < std::size_t(steps); ++step) {
             const double a = t0 + double(step) * stepLength;
-            const double b = std::min(t1, a + stepLength);
             if (a > t1) {
                 break;
             }
-            Box part;
-            for (int axis = 0; axis < D; ++axis) {
-                const double pa = origin[axis] + a * direction[axis];
-                const double pb = origin[axis] + b * direction[axis];
-                const double pad = 1e-6 * (std::fabs(pa) + std::fabs(pb) + cellSize_);
-                part.lo[axis] = Scalar(std::min(pa, pb) + double(ray.expandLo[axis]) - pad);
-                part.hi[axis] = Scalar(std::max(pa, pb) + double(ray.expandHi[axis]) + pad);
-            }
-            const Range range = rangeOf(part);
+            const Range range = rangeOf(segmentBox(a, std::min(t1, a + stepLength)));
             index_.forEachLiveIn(range, [&](std::uint32_t cell) {
                 if (havePrevious && previous.contains(index_.key(cell))) {
                     return;
@@ -433,6 +469,25 @@ class CellGrid {
         return counted > 0 ? sum / double(counted) : 0;
     }
 
+    /// A double as Scalar, rounded towards -inf / +inf (saturating at the Scalar range).
+    static Scalar roundedDown(double x) {
+        Scalar s = static_cast<Scalar>(x);
+        return double(s) > x ? std::nextafter(s, -std::numeric_limits<Scalar>::infinity()) : s;
+    }
+    static Scalar roundedUp(double x) {
+        Scalar s = static_cast<Scalar>(x);
+        return double(s) < x ? std::nextafter(s, std::numeric_limits<Scalar>::infinity()) : s;
+    }
+    /// Every binned object once.
+    template <class Visit>
+    void visitAllBinned(Visit& visit) const {
+        for (ObjectId id = 0; id < objects_.size(); ++id) {
+            if (objects_[id].state == State::InCells) {
+                visit(id);
+            }
+        }
+    }
+
     Range rangeOf(const Box& box) const {
         Range range;
         for (int axis = 0; axis < D; ++axis) {
@@ -443,12 +498,13 @@ class CellGrid {
     }
     Coord coordinate(double x, int axis) const {
         double c = (x - origin_[axis]) * inverseCellSize_;
-        // Clamp first, then floor by truncation (std::floor is a library call on baseline
-        // x86-64, and this runs for every setAabb).
+        // Clamp first (a NaN to the low end: no undefined conversion), then floor by
+        // truncation (std::floor is a library call on baseline x86-64, and this runs for
+        // every setAabb).
         if constexpr (Index::kBounded) {
-            c = std::min(std::max(c, 0.0), double(dims_[axis]) - 0.5);
+            c = c >= 0.0 ? std::min(c, double(dims_[axis]) - 0.5) : 0.0;
         } else {
-            c = std::min(std::max(c, -kKeyLimit), kKeyLimit);
+            c = c >= -kKeyLimit ? std::min(c, kKeyLimit) : -kKeyLimit;
         }
         const std::int64_t truncated = static_cast<std::int64_t>(c);
         return static_cast<Coord>(truncated - (c < double(truncated) ? 1 : 0));
