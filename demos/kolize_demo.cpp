@@ -11,6 +11,7 @@
 #include <kolize/engine/statistics.h>
 #include <kolize/engine/store_only.h>
 #include <kolize/engine/world_scene.h>
+#include <kolize/broadphase/bullet_adapter.h>
 #include <kolize/kolize.h>
 
 #include <btBulletDynamicsCommon.h>
@@ -464,6 +465,9 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
             }
         }
         result.finalPositions = scene->positions();
+        // What the broadphase used: for "auto", the core it chose last and why.
+        const auto* adapter = dynamic_cast<const kolize::BroadphaseAdapter*>(&scene->broadphase());
+        r.text("core", adapter != nullptr ? adapter->coreDescription() : name);
         r.number("init_ms", initMs, 3);
         r.number("step_ms", kolize::median(stepMs), 4);
         r.number("broadphase_ms", kolize::median(broadphaseMs), 4);
@@ -500,6 +504,7 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
 Record ordered(const Record& record) {
     static const char* kKeys[] = {"scene",
                                   "broadphase",
+                                  "core",
                                   "mode",
                                   "precision",
                                   "objects",
@@ -606,6 +611,11 @@ void printTable(const std::string& title, const std::vector<Record>& rows,
                                                    : same.c_str());
         }
         std::printf("\n");
+    }
+    for (const Record& row : rows) {
+        if (row["broadphase"] == "auto" && !row["core"].empty()) {
+            std::printf("  %s\n", row["core"].c_str());
+        }
     }
     std::fflush(stdout);
 }

@@ -623,7 +623,9 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
             // Meaningful: the lattice's neighbours overlap now and then, and queries hit.
             EXPECT_GT(overlapsSeen, 120u * 50);
             EXPECT_GT(queryHits, 120u);
-            if (margin == 0 || adapter->coreTracksOverlaps()) {
+            if (name == "auto") {
+                // Switches between cores with and without fat boxes: exactness is the check.
+            } else if (margin == 0 || adapter->coreTracksOverlaps()) {
                 EXPECT_EQ(stats.movesInsideFatBoxes, 0u);
                 EXPECT_EQ(stats.candidatePairs, stats.overlappingPairs);
             } else {
@@ -637,6 +639,92 @@ TEST(FatBoxes, JitterInsideAndSlowSlidesOutGiveExactPairsAndQueries) {
             }
         }
     }
+}
+
+}  // namespace
+}  // namespace kolize
+
+namespace kolize {
+namespace {
+
+/// Logs every add and remove the cache makes (installed like btGhostPairCallback).
+class PairLog : public btOverlappingPairCallback {
+  public:
+    btBroadphasePair* addOverlappingPair(btBroadphaseProxy* a, btBroadphaseProxy* b) override {
+        added.push_back(uidPair(a, b));
+        return nullptr;
+    }
+    void* removeOverlappingPair(btBroadphaseProxy* a, btBroadphaseProxy* b,
+                                btDispatcher*) override {
+        removed.push_back(uidPair(a, b));
+        return nullptr;
+    }
+    void removeOverlappingPairsContainingProxy(btBroadphaseProxy*, btDispatcher*) override {}
+    std::vector<UidPair> added, removed;
+};
+
+// "auto" measures the scene and switches its core when the motion changes (slow jitter:
+// sweep; fast scatter: grid). A switch must not touch a pair that keeps overlapping: no
+// remove-and-add, so cached collision algorithms survive. Pairs stay exact throughout.
+TEST(Auto, SwitchesItsCoreWithoutTouchingPairsThatPersist) {
+    auto broadphase = makeBroadphase("auto");
+    auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+    PairLog log;
+    broadphase->getOverlappingPairCache()->setInternalGhostPairCallback(&log);
+    std::mt19937 random(4);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    std::vector<btBroadphaseProxy*> proxies;
+    BoxMap boxes;
+    static char client;
+    for (int i = 0; i < 300; ++i) {
+        const btVector3 lo(btScalar(1.2 * (i % 10)), btScalar(1.2 * (i / 10 % 10)),
+                           btScalar(1.2 * (i / 100)));
+        ProxyBox box{nullptr, lo, lo + btVector3(1.3f, 1.3f, 1.3f)};
+        box.proxy = broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+        proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+        boxes[box.proxy] = box;
+    }
+    std::set<std::string> cores;
+    int switches = 0;
+    std::string previous = adapter.coreDescription();
+    std::vector<UidPair> before = cachedPairs(*broadphase->getOverlappingPairCache());
+    for (int frame = 0; frame < 420; ++frame) {
+        const bool fast = frame >= 140 && frame < 280;
+        for (btBroadphaseProxy* proxy : proxies) {
+            ProxyBox& box = boxes[proxy];
+            const btScalar scale = btScalar(fast ? 1.5 : 1e-3);
+            btVector3 step(btScalar(unit(random)) * scale, btScalar(unit(random)) * scale,
+                           btScalar(unit(random)) * scale);
+            if (fast && box.aabbMin.length() > 40) {
+                step = -box.aabbMin * btScalar(0.1);  // stay in the region
+            }
+            box.aabbMin += step;
+            box.aabbMax += step;
+            broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+        }
+        log.added.clear();
+        log.removed.clear();
+        const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+        ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+        const std::string description = adapter.coreDescription();
+        cores.insert(description.substr(0, description.find(' ', 6)));
+        if (description != previous) {
+            ++switches;
+            // Pairs overlapping before and after the switch were neither removed nor added.
+            std::vector<UidPair> persisting;
+            std::set_intersection(before.begin(), before.end(), pairs.cached.begin(),
+                                  pairs.cached.end(), std::back_inserter(persisting));
+            for (const UidPair& pair : log.removed) {
+                EXPECT_FALSE(std::binary_search(persisting.begin(), persisting.end(), pair))
+                    << "frame " << frame << ": a persisting pair was removed at the switch";
+            }
+            previous = description;
+        }
+        before = pairs.cached;
+        adapter.validate();
+    }
+    EXPECT_GE(switches, 2) << "the motion changed twice; auto should have followed";
+    EXPECT_GE(cores.size(), 2u);
 }
 
 }  // namespace

@@ -301,6 +301,9 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
+        if (measuring_) {
+            noteMotion(boxes_[slot], box);
+        }
         if (coreTracksOverlaps_) {
             // The core finds the changed pairs itself: no fat box, no certificate.
             boxes_[slot] = box;
@@ -387,6 +390,15 @@ void BroadphaseAdapter::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax
     aabbMax.setValue(all.hi[0], all.hi[1], all.hi[2]);
 }
 
+void BroadphaseAdapter::noteMotion(const Box& from, const Box& to) {
+    double size = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        size = std::max(size, double(to.hi[axis]) - double(to.lo[axis]));
+    }
+    measuredChanges_ += 1;
+    measuredMotion_ += std::min(1e3, motion(from, to) / std::max(size, 1e-30));
+}
+
 bool BroadphaseAdapter::usableQueryBox(const btVector3& aabbMin, const btVector3& aabbMax) {
     for (int axis = 0; axis < 3; ++axis) {
         if (!(aabbMin[axis] <= aabbMax[axis])) {  // inverted, or NaN
@@ -412,7 +424,10 @@ Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
     return ray;
 }
 
-std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery() {
+std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery(bool ray) {
+    if (measuring_) {
+        (ray ? measuredRays_ : measuredQueries_) += 1;
+    }
     // A deque: a nested query's new level does not move the lists of the levels below.
     if (queryDepth_ == queryScratch_.size()) {
         queryScratch_.emplace_back();
@@ -449,7 +464,12 @@ bool BroadphaseAdapter::beginPairs() {
     if (processing_.empty()) {
         ++counters_.idleFrames;
     }
+    ++measuredFrames_;
     // The core's all-pairs search pays when many objects moved (and on the first frame).
+    if (forceFullSearch_) {
+        forceFullSearch_ = false;
+        return true;
+    }
     return counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
 }
 
@@ -714,6 +734,125 @@ void BroadphaseAdapter::finishTrackedPairs(btDispatcher* dispatcher) {
     counters_.candidatesLastFrame = 0;
     counters_.pairsTestedLastFrame = testedThisFrame_;
     counters_.objectsLookedAtLastFrame = processing_.size();
+}
+
+SceneMeasure BroadphaseAdapter::takeMeasure() {
+    SceneMeasure out;
+    out.objects = liveCount_ - parkedCount_;
+    const double frames = std::max<double>(1, double(measuredFrames_));
+    out.frames = double(measuredFrames_);
+    out.movedPerFrame = measuredChanges_ / frames;
+    out.relativeMotion = measuredChanges_ > 0 ? measuredMotion_ / measuredChanges_ : 0;
+    out.raysPerFrame = measuredRays_ / frames;
+    out.boxQueriesPerFrame = measuredQueries_ / frames;
+    measuredChanges_ = measuredMotion_ = measuredRays_ = measuredQueries_ = 0;
+    measuredFrames_ = 0;
+    // Sizes and clustering from a sample of at most 1024 live boxes (planes and other
+    // boxes over 1e6 m left out).
+    std::vector<double> sizes;
+    std::vector<std::array<double, 3>> centres;
+    const std::size_t stride = boxes_.size() / 1024 + 1;
+    for (std::size_t slot = 0; slot < boxes_.size(); slot += stride) {
+        if (state_[slot] != SlotState::Live) {
+            continue;
+        }
+        const Box& box = boxes_[slot];
+        double size = 0;
+        std::array<double, 3> centre;
+        for (int axis = 0; axis < 3; ++axis) {
+            size = std::max(size, double(box.hi[axis]) - double(box.lo[axis]));
+            centre[axis] = 0.5 * (double(box.lo[axis]) + double(box.hi[axis]));
+        }
+        if (size < 1e6) {
+            sizes.push_back(size);
+            centres.push_back(centre);
+        }
+    }
+    if (sizes.size() < 8) {
+        return out;
+    }
+    std::vector<double> sorted = sizes;
+    std::sort(sorted.begin(), sorted.end());
+    const double p10 = sorted[sorted.size() / 10], p90 = sorted[sorted.size() * 9 / 10];
+    const double median = sorted[sorted.size() / 2];
+    out.sizeSpread = p10 > 0 ? p90 / p10 : (p90 > 0 ? 1e9 : 1);
+    // Clustering: sampled centres per occupied coarse cell (4 median sizes), against what
+    // the same count spread evenly over the centres' bounds would give.
+    std::array<double, 3> lo, hi;
+    lo.fill(HUGE_VAL);
+    hi.fill(-HUGE_VAL);
+    for (const auto& c : centres) {
+        for (int axis = 0; axis < 3; ++axis) {
+            lo[axis] = std::min(lo[axis], c[axis]);
+            hi[axis] = std::max(hi[axis], c[axis]);
+        }
+    }
+    const double cell = std::max(4 * median, 1e-30);
+    double cellsSpanned = 1;
+    for (int axis = 0; axis < 3; ++axis) {
+        cellsSpanned *= std::max(1.0, std::ceil((hi[axis] - lo[axis]) / cell));
+    }
+    std::vector<std::uint64_t> keys;
+    for (const auto& c : centres) {
+        std::uint64_t key = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+            key = key * 2097152 + std::uint64_t(std::min(2097151.0, (c[axis] - lo[axis]) / cell));
+        }
+        keys.push_back(key);
+    }
+    std::sort(keys.begin(), keys.end());
+    const double occupied = double(std::unique(keys.begin(), keys.end()) - keys.begin());
+    const double even = std::min(double(centres.size()), cellsSpanned);
+    out.clustering = even / occupied;
+    return out;
+}
+
+void BroadphaseAdapter::prepareCoreSwitch(bool tracking, btDispatcher* dispatcher) {
+    // Every pair's status made current by an exact test (a switch is rare: O(pairs) once).
+    ++deferErasures_;
+    for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+        PairStore::Pair& pair = pairs_[at];
+        const ObjectId a = pair.object[0], b = pair.object[1];
+        if (overlaps(boxes_[a], boxes_[b])) {
+            if (pair.status == PairStore::Status::Apart) {
+                ++overlapping_;
+                applyFilter(at, false, dispatcher);
+            }
+        } else {
+            uncache(at, dispatcher);
+            if (tracking) {
+                doomed_.push_back(at);  // a tracking core keeps only overlapping pairs
+            }
+        }
+    }
+    --deferErasures_;
+    erasePairs(doomed_);
+    for (std::size_t slot = 0; slot < boxes_.size(); ++slot) {
+        if (state_[slot] == SlotState::Live) {
+            fat_[slot] = boxes_[slot];
+            travel_[slot] = 0;
+        }
+    }
+    if (!tracking) {
+        // No certificates yet: every pair is tested at the next (full) search.
+        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+            pairs_[at].slack = -1;
+            pairs_.setTrigger(at, 0, -HUGE_VAL);
+            pairs_.setTrigger(at, 1, -HUGE_VAL);
+        }
+    }
+}
+
+void BroadphaseAdapter::finishCoreSwitch(bool tracking) {
+    coreTracksOverlaps_ = tracking;
+    for (std::size_t slot = 0; slot < boxes_.size(); ++slot) {
+        if (state_[slot] == SlotState::Live) {
+            coreInsert(ObjectId(slot), fat_[slot]);
+            noteMoved(ObjectId(slot), kExactMoved | kCoreMoved);
+        }
+    }
+    trackedBoxesChanged_ = tracking;
+    forceFullSearch_ = !tracking;
 }
 
 void BroadphaseAdapter::resetPool(btDispatcher* /*dispatcher*/) {

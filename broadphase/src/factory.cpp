@@ -46,8 +46,9 @@ void requireWorldBounds(std::string_view name, const BroadphaseSettings& setting
 
 const std::vector<std::string>& broadphaseNames() {
     static const std::vector<std::string> names = {
-        "grid",        "spatial-tree", "spatial-hash", "segment-trees", "range-tree", "sweep",
-        "brute-force", "dbvt",         "sap",          "sap-noray",     "sap32",      "simple"};
+        "auto",       "grid",  "spatial-tree", "spatial-hash", "segment-trees",
+        "range-tree", "sweep", "brute-force",  "dbvt",         "sap",
+        "sap-noray",  "sap32", "simple"};
     return names;
 }
 
@@ -60,7 +61,7 @@ std::string broadphaseNameList() {
 }
 
 bool isExactBroadphase(std::string_view name) {
-    return name == "grid" || name == "spatial-tree" || name == "spatial-hash" ||
+    return name == "auto" || name == "grid" || name == "spatial-tree" || name == "spatial-hash" ||
            name == "segment-trees" || name == "range-tree" || name == "sweep" ||
            name == "brute-force";
 }
@@ -96,6 +97,13 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
         tree.incremental = false;
         return std::make_unique<CoreBroadphase<RangeTree<3, btScalar>>>(std::string(name), settings,
                                                                         tree);
+    }
+    if (name == "auto") {
+        AutoSettings automatic;
+        automatic.cells = settings.cells;
+        automatic.segmentTrees = settings.segmentTrees;
+        return std::make_unique<CoreBroadphase<AutoCore<3, btScalar>>>(std::string(name), settings,
+                                                                       automatic);
     }
     if (name == "sweep") {
         return std::make_unique<CoreBroadphase<SweepAndPrune<3, btScalar>>>(std::string(name),

@@ -31,6 +31,7 @@
 /// the next pair search.
 
 #include <kolize/broadphase/aabb.h>
+#include <kolize/broadphase/auto_core.h>
 #include <kolize/broadphase/pair_store.h>
 #include <kolize/broadphase/settings.h>
 
@@ -40,6 +41,7 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <type_traits>
 #include <limits>
 #include <memory>
 #include <string>
@@ -123,6 +125,8 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// reproducible runs. Does nothing while proxies are alive.
     void resetPool(btDispatcher* dispatcher) override;
     void printStats() override;
+    /// The core in use and, for "auto", what it measured and why it chose it.
+    virtual std::string coreDescription() const { return name_; }
 
     const std::string& name() const { return name_; }
     /// True when the core tracks overlaps itself ("sweep"): exact boxes in the core, no fat
@@ -168,7 +172,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
 
     /// Scratch for one query: collect the hits into it, then call reportHits. Queries
     /// nest (a callback may query again); each level has its own list.
-    std::vector<QueryHit>& beginQuery();
+    std::vector<QueryHit>& beginQuery(bool ray);
     void addHit(std::vector<QueryHit>& hits, ObjectId id) const {
         hits.push_back(QueryHit{id, proxyOf(id)->m_uniqueId});
     }
@@ -341,6 +345,26 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     AdapterStats counters_;
 
     void endQuery() { --queryDepth_; }
+
+  protected:
+    // --- for "auto": the scene's measure, and a switch of core without losing a pair ---
+    /// Starts measuring (motion per setAabb, rays and box queries).
+    void startMeasuring() { measuring_ = true; }
+    void noteMotion(const Box& from, const Box& to);
+    /// What was measured since the last call; resets the accumulators. O(sampled objects).
+    SceneMeasure takeMeasure();
+    /// Before the core is replaced: every pair tested (statuses current, the cache
+    /// updated), core boxes made exact; with `tracking` (the new core tracks overlaps) the
+    /// apart pairs are erased, without it every pair awaits a test at a full search.
+    void prepareCoreSwitch(bool tracking, btDispatcher* dispatcher);
+    /// After the core was emptied: inserts every live object again, sets the mode.
+    void finishCoreSwitch(bool tracking);
+
+  private:
+    bool measuring_ = false;
+    bool forceFullSearch_ = false;
+    double measuredChanges_ = 0, measuredMotion_ = 0, measuredRays_ = 0, measuredQueries_ = 0;
+    std::size_t measuredFrames_ = 0;
 };
 
 /// A btBroadphaseInterface over a kolize core. `Core` provides insert / update / remove,
@@ -355,19 +379,27 @@ class CoreBroadphase final : public BroadphaseAdapter {
         : BroadphaseAdapter(std::move(name), settings),
           coreSettings_(coreSettings),
           core_(coreSettings) {
-        coreTracksOverlaps_ = tracksOverlaps();
+        coreTracksOverlaps_ = tracksNow();
+        if constexpr (kAuto) {
+            startMeasuring();
+        }
     }
 
     void calculateOverlappingPairs(btDispatcher* dispatcher) override {
         if (busy()) {
             return;
         }
-        if constexpr (tracksOverlaps()) {
-            beginPairs();
-            core_.maintain();
-            core_.drainChanges([&](ObjectId a, ObjectId b) { noteCoreChange(a, b); });
-            finishTrackedPairs(dispatcher);
-            return;
+        if constexpr (kAuto) {
+            chooseCore(dispatcher);
+        }
+        if constexpr (mayTrack()) {
+            if (coreTracksOverlaps_) {
+                beginPairs();
+                core_.maintain();
+                core_.drainChanges([&](ObjectId a, ObjectId b) { noteCoreChange(a, b); });
+                finishTrackedPairs(dispatcher);
+                return;
+            }
         }
         const bool full = beginPairs();
         core_.maintain();
@@ -401,7 +433,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
             return;
         }
         const Box query = toBox(aabbMin, aabbMax);
-        std::vector<QueryHit>& hits = beginQuery();
+        std::vector<QueryHit>& hits = beginQuery(false);
         core_.queryBox(query, [&](ObjectId id) {
             if (overlaps(boxOf(id), query)) {
                 addHit(hits, id);
@@ -417,7 +449,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
             return;
         }
         const Ray<3, btScalar> ray = toRay(rayFrom, callback, aabbMin, aabbMax);
-        std::vector<QueryHit>& hits = beginQuery();
+        std::vector<QueryHit>& hits = beginQuery(true);
         core_.queryRay(ray, [&](ObjectId id) {
             if (rayHits(boxOf(id), ray)) {
                 addHit(hits, id);
@@ -428,16 +460,55 @@ class CoreBroadphase final : public BroadphaseAdapter {
 
     const Core& core() const { return core_; }
 
+    std::string coreDescription() const override {
+        if constexpr (kAuto) {
+            return name() + ": " + Core::kindName(core_.kind()) + " (" + core_.reason() + "; " +
+                   std::to_string(core_.switches()) + " switches)";
+        } else {
+            return name();
+        }
+    }
+
   private:
+    static constexpr bool kAuto = std::is_same_v<Core, AutoCore<3, btScalar>>;
+    /// A core whose tracksOverlaps() may be true provides drainChanges.
     template <class C>
-    static constexpr auto tracks(int) -> decltype(C::kTracksOverlaps, bool()) {
-        return C::kTracksOverlaps;
+    static constexpr auto tracks(int)
+        -> decltype(std::declval<const C&>().tracksOverlaps(), bool()) {
+        return true;
     }
     template <class C>
     static constexpr bool tracks(long) {
         return false;
     }
-    static constexpr bool tracksOverlaps() { return tracks<Core>(0); }
+    static constexpr bool mayTrack() { return tracks<Core>(0); }
+    bool tracksNow() const {
+        if constexpr (mayTrack()) {
+            return core_.tracksOverlaps();
+        } else {
+            return false;
+        }
+    }
+
+    /// "auto": measure, decide, and switch the core when the decision changed.
+    void chooseCore(btDispatcher* dispatcher) {
+        if constexpr (kAuto) {
+            const std::size_t frame = stats().frames;
+            const std::size_t every = std::size_t(std::max(1, coreSettings_.evaluateEvery));
+            if (frame == 0 || (frame != 2 && frame % every != 0)) {
+                return;
+            }
+            const SceneMeasure measure = takeMeasure();
+            const typename Core::Kind wanted = core_.decide(measure);
+            if (wanted == core_.kind()) {
+                return;
+            }
+            const bool tracking = wanted == Core::Kind::Sweep;
+            prepareCoreSwitch(tracking, dispatcher);
+            core_.switchTo(wanted, core_.lastRuleReason());
+            finishCoreSwitch(tracking);
+        }
+    }
 
     void coreInsert(ObjectId id, const Box& box) override { core_.insert(id, box); }
     void coreUpdate(ObjectId id, const Box& box) override { core_.update(id, box); }

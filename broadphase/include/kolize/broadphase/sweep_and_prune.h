@@ -14,7 +14,7 @@
 /// created or removed between two frames are merged in (or compacted out) once per frame,
 /// in O(N + their overlaps), instead of one O(N) insertion each.
 ///
-/// The core tracks overlaps itself (kTracksOverlaps): the adapter takes the changed pairs
+/// The core tracks overlaps itself (tracksOverlaps()): the adapter takes the changed pairs
 /// from drainChanges and tests only those. A pair appears there whenever the boxes' overlap
 /// may have changed (a superset: each swap of a min and a max of two objects whose other
 /// axes overlap, and every pair of an object merged in). queryBox scans the first axis up
@@ -97,7 +97,7 @@ class SweepAndPrune {
     using Box = Aabb<D, Scalar>;
     using Settings = SweepSettings;
     /// The adapter takes changed pairs from drainChanges instead of querying for candidates.
-    static constexpr bool kTracksOverlaps = true;
+    bool tracksOverlaps() const { return true; }
     /// Ids are stored in 31 bits with the float layout.
     static constexpr ObjectId kMaxId = 0x7fffffffu;
 

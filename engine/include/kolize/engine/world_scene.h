@@ -5,6 +5,7 @@
 /// measures the dynamics' health (penetration, escaped bodies, NaN, energy). Scene builders
 /// (scene registry, FallingBoxesWorld) fill it with bodies.
 
+#include <kolize/engine/deterministic_islands.h>
 #include <kolize/engine/scene.h>
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
@@ -26,10 +27,12 @@ class btTypedConstraint;
 namespace kolize {
 
 /// A btDiscreteDynamicsWorld that times its broadphase work (updateAabbs +
-/// computeOverlappingPairs) separately from the rest of each step.
-class TimedDynamicsWorld : public btDiscreteDynamicsWorld {
+/// computeOverlappingPairs) separately from the rest of each step; its islands do not
+/// depend on the pair cache's order when m_deterministicOverlappingPairs is on
+/// (deterministic_islands.h).
+class TimedDynamicsWorld : public WithDeterministicIslands<btDiscreteDynamicsWorld> {
   public:
-    using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
+    using WithDeterministicIslands<btDiscreteDynamicsWorld>::WithDeterministicIslands;
     void performDiscreteCollisionDetection() override;
     /// Seconds spent in updateAabbs + computeOverlappingPairs during the last internal step.
     double lastBroadphaseSeconds() const { return lastBroadphaseSeconds_; }

@@ -1,0 +1,245 @@
+#pragma once
+/// \file
+/// AutoCore<D, Scalar>: the core of broadphase "auto". It holds one of kolize's cores at a
+/// time (grid, spatial-hash, segment-trees, sweep) and picks it from what it measures of
+/// the scene (SceneMeasure, filled in by the adapter): object count, how many move and how
+/// far against their size, the spread of sizes, clustering, and the rays and box queries
+/// per frame. When the scene changes it switches: the adapter rebuilds the new core from the
+/// current boxes without touching the pair cache (no pair lost, no cached algorithm freed).
+///
+/// The rules (measured with kolize-demo over the scene registry, see README):
+/// - many rays (at least max(16, N/64) per frame): grid, whose ray walk visits few cells
+///   (sweep tests every object per ray);
+/// - slow motion (the moving objects move less than a fifth of their size per frame, as in
+///   most Bullet worlds, resting or settling): sweep;
+/// - faster motion, sizes spread over more than 30x or objects clustered: segment-trees;
+/// - faster motion otherwise: grid.
+/// A choice must win two evaluations in a row (every 32 frames) and stands at least 128
+/// frames, so a scene on a threshold does not flip back and forth.
+
+#include <kolize/broadphase/aabb.h>
+#include <kolize/broadphase/cell_grid.h>
+#include <kolize/broadphase/segment_tree_set.h>
+#include <kolize/broadphase/sweep_and_prune.h>
+
+#include <cstdint>
+#include <string>
+
+namespace kolize {
+
+/// What the adapter measured of the scene since the last evaluation.
+struct SceneMeasure {
+    std::size_t objects = 0;
+    double frames = 0;          ///< pair searches covered
+    double movedPerFrame = 0;   ///< objects whose box changed, per frame
+    double relativeMotion = 0;  ///< mean over those moves of motion / box size
+    double sizeSpread = 1;      ///< 90th over 10th percentile of box sizes (sampled)
+    double clustering = 1;      ///< objects per occupied coarse cell over the uniform figure
+    double raysPerFrame = 0;
+    double boxQueriesPerFrame = 0;
+};
+
+/// Settings of broadphase "auto": the settings of the cores it may use.
+struct AutoSettings {
+    CellGridSettings cells;
+    SegmentTreeSettings segmentTrees;
+    /// Evaluate every this many pair searches (default 32).
+    int evaluateEvery = 32;
+};
+
+template <int D, class Scalar>
+class AutoCore {
+  public:
+    using Box = Aabb<D, Scalar>;
+    using Settings = AutoSettings;
+    enum class Kind : std::uint8_t { Grid, SpatialHash, SegmentTrees, Sweep };
+
+    explicit AutoCore(const Settings& settings = {})
+        : settings_(settings),
+          grid_(settings.cells),
+          hash_(settings.cells),
+          trees_(noKeptSet(settings.segmentTrees)) {}
+
+    static const char* kindName(Kind kind) {
+        switch (kind) {
+            case Kind::Grid:
+                return "grid";
+            case Kind::SpatialHash:
+                return "spatial-hash";
+            case Kind::SegmentTrees:
+                return "segment-trees";
+            case Kind::Sweep:
+                return "sweep";
+        }
+        return "?";
+    }
+
+    Kind kind() const { return kind_; }
+    bool tracksOverlaps() const { return kind_ == Kind::Sweep; }
+    /// Why the present core was chosen (for kolize-demo), and how many switches so far.
+    const std::string& reason() const { return reason_; }
+    std::size_t switches() const { return switches_; }
+
+    /// Given the scene's measure, the core it should use (the rules above, with the
+    /// hysteresis); sets reason().
+    Kind decide(const SceneMeasure& measure) {
+        const Kind wanted = rule(measure);
+        ++evaluations_;
+        framesSinceSwitch_ += std::size_t(measure.frames);
+        if (wanted == kind_) {
+            pending_ = kind_;
+            reason_ = ruleReason_;
+            return kind_;
+        }
+        if (wanted != pending_) {
+            pending_ = wanted;  // must win once more
+            return kind_;
+        }
+        if (framesSinceSwitch_ < 128 && switches_ > 0) {
+            return kind_;
+        }
+        return wanted;
+    }
+
+    /// Drops every object and makes `kind` the active core; the adapter inserts the
+    /// objects again.
+    void switchTo(Kind kind, const std::string& why) {
+        grid_ = UniformGrid<D, Scalar>(settings_.cells);
+        hash_ = SpatialHash<D, Scalar>(settings_.cells);
+        trees_ = SegmentTreeSet<D, Scalar>(noKeptSet(settings_.segmentTrees));
+        sweep_ = SweepAndPrune<D, Scalar>();
+        kind_ = kind;
+        pending_ = kind;
+        reason_ = why;
+        framesSinceSwitch_ = 0;
+        ++switches_;
+    }
+
+    /// The reason the last decide() gave for its rule (even when it did not switch).
+    const std::string& lastRuleReason() const { return ruleReason_; }
+
+    // --- the core concept: forwarded to the active core ---
+    void insert(ObjectId id, const Box& box) {
+        dispatch([&](auto& core) { core.insert(id, box); });
+    }
+    void update(ObjectId id, const Box& box) {
+        dispatch([&](auto& core) { core.update(id, box); });
+    }
+    void remove(ObjectId id) {
+        dispatch([&](auto& core) { core.remove(id); });
+    }
+    void maintain() {
+        dispatch([&](auto& core) { core.maintain(); });
+    }
+    template <class Sink>
+    void findCandidates(Sink&& sink) {
+        dispatch([&](auto& core) { core.findCandidates(sink); });
+    }
+    template <class Sink>
+    void drainChanges(Sink&& sink) {
+        if (kind_ == Kind::Sweep) {
+            sweep_.drainChanges(sink);
+        }
+    }
+    template <class Visit>
+    void queryBox(const Box& box, Visit&& visit) const {
+        dispatch([&](const auto& core) { core.queryBox(box, visit); });
+    }
+    template <class Visit>
+    void queryRay(const Ray<D, Scalar>& ray, Visit&& visit) const {
+        dispatch([&](const auto& core) { core.queryRay(ray, visit); });
+    }
+    void validate() const {
+        dispatch([&](const auto& core) { core.validate(); });
+    }
+    std::size_t memoryBytes() const {
+        return grid_.memoryBytes() + hash_.memoryBytes() + trees_.memoryBytes() +
+               sweep_.memoryBytes();
+    }
+
+  private:
+    static SegmentTreeSettings noKeptSet(SegmentTreeSettings settings) {
+        settings.incremental = false;  // the adapter keeps the candidate pairs itself
+        return settings;
+    }
+
+    Kind rule(const SceneMeasure& m) {
+        const double n = double(m.objects);
+        if (m.raysPerFrame >= std::max(16.0, n / 64)) {
+            ruleReason_ = std::to_string(int(m.raysPerFrame)) +
+                          " rays per frame: the grid walks rays through few cells";
+            return Kind::Grid;
+        }
+        if (m.movedPerFrame < 0.5 || m.relativeMotion < 0.2) {
+            ruleReason_ = "slow motion (" + std::to_string(int(m.movedPerFrame)) +
+                          " objects moved per frame, by " + shortNumber(m.relativeMotion) +
+                          " of their size): sorted endpoints move few places";
+            return Kind::Sweep;
+        }
+        if (m.sizeSpread > 30 || m.clustering > 8) {
+            ruleReason_ = "fast motion with sizes spread " + shortNumber(m.sizeSpread) +
+                          "x and clustering " + shortNumber(m.clustering) +
+                          ": segment trees do not depend on one cell size";
+            return Kind::SegmentTrees;
+        }
+        ruleReason_ = "fast motion (" + shortNumber(m.relativeMotion) +
+                      " of their size per frame), even sizes, spread out: one cell size fits";
+        return Kind::Grid;
+    }
+
+    static std::string shortNumber(double x) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.2g", x);
+        return text;
+    }
+
+    template <class F>
+    void dispatch(F&& f) {
+        switch (kind_) {
+            case Kind::Grid:
+                f(grid_);
+                return;
+            case Kind::SpatialHash:
+                f(hash_);
+                return;
+            case Kind::SegmentTrees:
+                f(trees_);
+                return;
+            case Kind::Sweep:
+                f(sweep_);
+                return;
+        }
+    }
+    template <class F>
+    void dispatch(F&& f) const {
+        switch (kind_) {
+            case Kind::Grid:
+                f(grid_);
+                return;
+            case Kind::SpatialHash:
+                f(hash_);
+                return;
+            case Kind::SegmentTrees:
+                f(trees_);
+                return;
+            case Kind::Sweep:
+                f(sweep_);
+                return;
+        }
+    }
+
+    Settings settings_;
+    UniformGrid<D, Scalar> grid_;
+    SpatialHash<D, Scalar> hash_;
+    SegmentTreeSet<D, Scalar> trees_;
+    SweepAndPrune<D, Scalar> sweep_;
+    Kind kind_ = Kind::Grid;
+    Kind pending_ = Kind::Grid;
+    std::string reason_ = "the start: no measure yet, the grid";
+    std::string ruleReason_;
+    std::size_t evaluations_ = 0;
+    std::size_t framesSinceSwitch_ = 0;
+    std::size_t switches_ = 0;
+};
+
+}  // namespace kolize
