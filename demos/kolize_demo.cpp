@@ -639,7 +639,12 @@ std::vector<Record> replayRecords(const kolize::PairStream& stream, const Option
                                   const std::string& sceneName,
                                   const kolize::BroadphaseSettings& settings) {
     std::vector<Record> rows;
-    for (const std::string& name : options.broadphases) {
+    // store-only (stores the boxes, finds no pairs) is the floor every replay is read against.
+    std::vector<std::string> names = options.broadphases;
+    if (std::find(names.begin(), names.end(), "store-only") == names.end()) {
+        names.push_back("store-only");
+    }
+    for (const std::string& name : names) {
         Record r;
         r.text("scene", sceneName);
         r.text("broadphase", name);

@@ -219,6 +219,9 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
             continue;
         }
         const bool zero = pairs.at(r, "missing") == "0" && pairs.at(r, "extra") == "0";
+        if (broadphase == "store-only") {
+            continue;  // the floor: finds no pairs by design
+        }
         if (kolize::isExactBroadphase(broadphase)) {
             ++runs[mode];
             exact[mode] += zero ? 1 : 0;
@@ -251,6 +254,46 @@ void pairSections(Context& context, const SceneList& scenes, Csv& pairs) {
         ". Runs that failed: " + orNone(errors) +
         ". Fastest broadphase per scene on the replayed stream: " + orNone(fastestPerScene) +
         ".\n");
+
+    // The floor: every replay against store-only's on the same stream.
+    context.heading("Each scene's frame split: the store-only floor and the broadphase's own work");
+    context.add(
+        "Replayed streams (identical input; no world): `store-only` only stores the boxes and "
+        "finds no pairs, the least any drop-in broadphase can cost on that stream. Cells: ms "
+        "per frame above the floor (the broadphase's own work), and in brackets the whole "
+        "frame as a multiple of the floor.\n\n");
+    std::vector<std::string> floorReading;
+    context.add(sceneByBroadphase(
+        scenes.names, broadphases, {"floor ms"},
+        [&](const std::string& scene) {
+            const long row = find(pairs, scene, "store-only", "replay");
+            return std::vector<std::string>{row < 0 ? "-"
+                                                    : fmt(pairs.number(row, "broadphase_ms"))};
+        },
+        [&](const std::string& scene, const std::string& broadphase) {
+            const long row = find(pairs, scene, broadphase, "replay");
+            const long floorRow = find(pairs, scene, "store-only", "replay");
+            if (row < 0 || floorRow < 0 || pairs.at(row, "status") != "ok") {
+                return std::string("-");
+            }
+            const double ms = pairs.number(row, "broadphase_ms");
+            const double floorMs = pairs.number(floorRow, "broadphase_ms");
+            return fmt(std::max(0.0, ms - floorMs)) + " (" + fmt(ms / floorMs) + "x)";
+        }));
+    for (const std::string& scene : scenes.names) {
+        const long floorRow = find(pairs, scene, "store-only", "replay");
+        const std::string best = fastest(pairs, scene, broadphases, "replay", "broadphase_ms", "");
+        const long bestRow =
+            best.empty() ? -1 : find(pairs, scene, best.substr(0, best.find(' ')), "replay");
+        if (floorRow >= 0 && bestRow >= 0) {
+            floorReading.push_back(scene + " " +
+                                   fmt(pairs.number(bestRow, "broadphase_ms") /
+                                       pairs.number(floorRow, "broadphase_ms")) +
+                                   "x");
+        }
+    }
+    context.add("\n**Reading:** the fastest broadphase's frame as a multiple of the floor: " +
+                orNone(floorReading) + ".\n");
 
     // Rays: only scenes that cast them.
     context.heading("Ray casts");
