@@ -169,8 +169,8 @@ bool overlap(const Obb& a, const Obb& b, const RelativePose& bInA) {
     const Vec3 d = moved.center - a.center.cast<double>();
     const float slack =
         detail::roundUp(positionSlack(a.center.cast<double>(), b.center.cast<double>(), bInA));
-    return detail::obbSeparatingAxis(a, a.axis2(), moved, d, slack, detail::kNoAxis) ==
-           detail::kNoAxis;
+    return detail::obbSeparatingAxis(a, a.axis2(), moved, d.x(), d.y(), d.z(), slack,
+                                     detail::kNoAxis) == detail::kNoAxis;
 }
 
 template <int K>
@@ -206,8 +206,8 @@ Obb transformed(const Obb& box, const RelativePose& pose) {
     const detail::ObbInFrame moved = detail::moveObb(box, pose.rotation(), pose.translation());
     Obb out;
     out.center = moved.center.cast<float>();
-    out.axis0 = moved.axis[0];
-    out.axis1 = moved.axis[1];
+    out.axis0 = moved.axis(0);
+    out.axis1 = moved.axis(1);
     // The new float axes differ from the exactly rotated ones by a few float ulps, and the
     // centre by its rounding: every point of the moved box lies within `drift` of the new
     // box, which the enlarged extents absorb (the axes are orthonormal to ~1e-6).

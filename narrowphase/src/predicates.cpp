@@ -91,6 +91,27 @@ int crossTerm(int alen, const double* a, int blen, const double* b, int clen, co
     return expansionSum(ablen, ab, cdlen, cd, h);
 }
 
+/// Exact sign of det[x, y, z] for double vectors (every product exact by two-product).
+/// Straight-line: each 2x2 minor is a 4-term expansion, each term 8, the sum at most 24.
+int determinantSign(const double x[3], const double y[3], const double z[3]) {
+    double terms[3][8];
+    int lengths[3];
+    for (int k = 0; k < 3; ++k) {
+        const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        double p1, p0, q1, q0;
+        twoProduct(y[k1], z[k2], p1, p0);
+        twoProduct(y[k2], z[k1], q1, q0);
+        const double left[2] = {p0, p1}, right[2] = {-q0, -q1};
+        double minor[4];
+        const int minorLength = expansionSum(2, left, 2, right, minor);
+        lengths[k] = scaleExpansion(minorLength, minor, x[k], terms[k]);
+    }
+    double partial[16], total[24];
+    const int partialLength = expansionSum(lengths[0], terms[0], lengths[1], terms[1], partial);
+    const int totalLength = expansionSum(partialLength, partial, lengths[2], terms[2], total);
+    return sign(totalLength, total);
+}
+
 std::optional<int> orient3dExpansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
     for (const Vec3* p : {&a, &b, &c, &d}) {
         for (int k = 0; k < 3; ++k) {
@@ -103,10 +124,20 @@ std::optional<int> orient3dExpansion(const Vec3& a, const Vec3& b, const Vec3& c
     // det = x . (y cross z).
     double x[3][2], y[3][2], z[3][2];
     int xl[3], yl[3], zl[3];
+    bool exactDifferences = true;
     for (int k = 0; k < 3; ++k) {
         xl[k] = differenceExpansion(b[k], a[k], x[k]);
         yl[k] = differenceExpansion(c[k], a[k], y[k]);
         zl[k] = differenceExpansion(d[k], a[k], z[k]);
+        exactDifferences = exactDifferences && xl[k] == 1 && yl[k] == 1 && zl[k] == 1;
+    }
+    if (exactDifferences) {
+        // Float-derived data (a mesh on its own copy, shifted by a power of two): every
+        // difference is a double, and the short fixed-size path decides.
+        const double xs[3] = {x[0][0], x[1][0], x[2][0]};
+        const double ys[3] = {y[0][0], y[1][0], y[2][0]};
+        const double zs[3] = {z[0][0], z[1][0], z[2][0]};
+        return determinantSign(xs, ys, zs);
     }
     double total[192];
     int totalLength = 1;
@@ -135,6 +166,14 @@ std::optional<int> orient2dExpansion(double ax, double ay, double bx, double by,
     double ux[2], uy[2], vx[2], vy[2], det[16];
     const int uxl = differenceExpansion(bx, ax, ux), uyl = differenceExpansion(by, ay, uy);
     const int vxl = differenceExpansion(cx, ax, vx), vyl = differenceExpansion(cy, ay, vy);
+    if (uxl == 1 && uyl == 1 && vxl == 1 && vyl == 1) {
+        double p1, p0, q1, q0;
+        twoProduct(ux[0], vy[0], p1, p0);
+        twoProduct(uy[0], vx[0], q1, q0);
+        const double left[2] = {p0, p1}, right[2] = {-q0, -q1};
+        const int length = expansionSum(2, left, 2, right, det);
+        return sign(length, det);
+    }
     const int length = crossTerm(uxl, ux, vyl, vy, uyl, uy, vxl, vx, det);
     return sign(length, det);
 }
@@ -195,6 +234,14 @@ int orient2dGmp(double ax, double ay, double bx, double by, double cx, double cy
 
 int orient3dExact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
                   PredicateStats* stats) {
+    // Two equal points make the determinant exactly zero (a mesh against its own copy
+    // shares every vertex): decided without exact arithmetic, counted with the filter.
+    if (d == a || d == b || d == c || a == b || a == c || b == c) {
+        if (stats != nullptr) {
+            ++stats->orient3d[0];
+        }
+        return 0;
+    }
     if (const std::optional<int> s = orient3dExpansion(a, b, c, d)) {
         if (stats != nullptr) {
             ++stats->orient3d[1];
@@ -209,6 +256,12 @@ int orient3dExact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 
 int orient2dExact(double ax, double ay, double bx, double by, double cx, double cy,
                   PredicateStats* stats) {
+    if ((ax == bx && ay == by) || (ax == cx && ay == cy) || (bx == cx && by == cy)) {
+        if (stats != nullptr) {
+            ++stats->orient2d[0];
+        }
+        return 0;
+    }
     if (const std::optional<int> s = orient2dExpansion(ax, ay, bx, by, cx, cy)) {
         if (stats != nullptr) {
             ++stats->orient2d[1];
