@@ -247,6 +247,8 @@ const char* poseClassName(PoseClass kind) {
             return "near";
         case PoseClass::kApart:
             return "apart";
+        case PoseClass::kApartObb:
+            return "apart-obb";
         case PoseClass::kCoincident:
             return "coincident";
         case PoseClass::kShifted:
@@ -256,9 +258,9 @@ const char* poseClassName(PoseClass kind) {
 }
 
 const std::vector<PoseClass>& allPoseClasses() {
-    static const std::vector<PoseClass> classes = {PoseClass::kDeep,       PoseClass::kShallow,
-                                                   PoseClass::kNear,       PoseClass::kApart,
-                                                   PoseClass::kCoincident, PoseClass::kShifted};
+    static const std::vector<PoseClass> classes = {
+        PoseClass::kDeep,     PoseClass::kShallow,    PoseClass::kNear,   PoseClass::kApart,
+        PoseClass::kApartObb, PoseClass::kCoincident, PoseClass::kShifted};
     return classes;
 }
 
@@ -336,6 +338,36 @@ std::vector<WorkloadPose> makePoses(const WorkloadMesh& a, const MeshModel& mode
                 s = free + (0.002 + 0.018 * unit(rng)) * r;
                 break;
             case PoseClass::kApart: {
+                // World AABBs (of the vertices, as Bullet's broadphase sees them) overlap for
+                // s in an interval; its upper end per axis is (hiA - loB) / d (d > 0).
+                Vec3 loA = Vec3::Constant(1e300), hiA = -loA, loB = loA, hiB = -loA;
+                for (const Vec3& v : a.mesh->vertices()) {
+                    const Vec3 w = pa.rotation * v + pa.translation;
+                    loA = loA.cwiseMin(w);
+                    hiA = hiA.cwiseMax(w);
+                }
+                const Pose b0 = at(0.0);
+                for (const Vec3& v : b.mesh->vertices()) {
+                    const Vec3 w = b0.rotation * v + b0.translation;
+                    loB = loB.cwiseMin(w);
+                    hiB = hiB.cwiseMax(w);
+                }
+                double boxInside = 1e300;
+                for (int k = 0; k < 3; ++k) {
+                    if (direction[k] > 0) {
+                        boxInside = std::min(boxInside, (hiA[k] - loB[k]) / direction[k]);
+                    } else if (direction[k] < 0) {
+                        boxInside = std::min(boxInside, (loA[k] - hiB[k]) / direction[k]);
+                    }
+                }
+                const double lower = free + 0.02 * r;
+                if (boxInside <= lower) {
+                    continue;
+                }
+                s = lower + (boxInside - lower) * unit(rng);
+                break;
+            }
+            case PoseClass::kApartObb: {
                 // The root boxes overlap on an interval of s (convex sets on a line).
                 double boxInside = free, boxFree = 4 * sMax;
                 for (int k = 0; k < 44; ++k) {

@@ -406,20 +406,33 @@ void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFr
     ops.finish();
 }
 
+/// Largest |(R^T R - I)_ij|, NaN when anything is not finite. Scalar: it runs every query.
+double orthonormalityError(const Eigen::Matrix3d& r, const Vec3& t) {
+    double error = 0;
+    bool finite = std::isfinite(t.x() + t.y() + t.z());
+    for (int i = 0; i < 3; ++i) {
+        for (int j = i; j < 3; ++j) {
+            const double dot = (r(0, i) * r(0, j) + r(1, i) * r(1, j)) + r(2, i) * r(2, j);
+            const double e = std::fabs(dot - (i == j ? 1.0 : 0.0));
+            finite = finite && std::isfinite(dot);
+            error = std::max(error, e);
+        }
+    }
+    return finite ? error : std::numeric_limits<double>::quiet_NaN();
+}
+
 void checkPose(const Pose& pose, const MeshModel& model, const char* which) {
+    const double error = orthonormalityError(pose.rotation, pose.translation);
+    if (error <= detail::kMaxOrthonormalityError) {
+        return;  // the common case: one scalar pass, no allocation
+    }
     if (!pose.rotation.allFinite() || !pose.translation.allFinite()) {
         throw std::invalid_argument(std::string("pose of mesh ") + which + " ('" +
                                     model.mesh().name() + "') is not finite");
     }
-    const double error = (pose.rotation.transpose() * pose.rotation - Eigen::Matrix3d::Identity())
-                             .cwiseAbs()
-                             .maxCoeff();
-    if (!(error <= detail::kMaxOrthonormalityError)) {
-        throw std::invalid_argument(
-            std::string("pose of mesh ") + which + " ('" + model.mesh().name() +
-            "') has a rotation that is not orthonormal (|R^T R - I| = " + std::to_string(error) +
-            ", at most 1e-6 accepted)");
-    }
+    throw std::invalid_argument(std::string("pose of mesh ") + which + " ('" + model.mesh().name() +
+                                "') has a rotation that is not orthonormal (|R^T R - I| = " +
+                                std::to_string(error) + ", at most 1e-6 accepted)");
 }
 
 }  // namespace
@@ -455,13 +468,20 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
                                     "' a " + treeKindName(b.kind()) +
                                     " tree; both must be of one kind");
     }
-    checkPose(poseA, a, "A");
-    checkPose(poseB, b, "B");
+    // The query works in A's frame: its soundness needs B's rotation there to be orthonormal
+    // (within 3e-6, which two rotations orthonormal within 1e-6 give). Only when it is not
+    // are the two poses examined, to name the bad one.
+    const RelativePose relative(poseA, poseB);
+    if (!(orthonormalityError(relative.rotation(), relative.translation()) <= 3e-6)) {
+        checkPose(poseA, a, "A");
+        checkPose(poseB, b, "B");
+        throw std::invalid_argument("poses of meshes '" + a.mesh().name() + "' and '" +
+                                    b.mesh().name() +
+                                    "': the relative rotation is not orthonormal");
+    }
     result_.intersecting = false;
     result_.pairs.clear();
     result_.contacts.clear();
-    result_.counters = QueryCounters{};
-    const RelativePose relative(poseA, poseB);
     QueryScratch::Impl& s = scratch.impl();
     const std::size_t vertexCount = b.mesh().vertices().size();
     if (s.vertexStamp.size() < vertexCount) {
@@ -483,7 +503,7 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
               s,
               s.nextStamp(),
               result_,
-              result_.counters};
+              QueryCounters()};
 
     Front& front = *front_;
     if (settings.sphere_pretest) {

@@ -168,6 +168,7 @@ inline void expectMeaningfulClasses(const std::map<workload::PoseClass, ClassTal
                 break;
             case PoseClass::kNear:
             case PoseClass::kApart:
+            case PoseClass::kApartObb:
                 EXPECT_LE(share, 0.25)
                     << what << " " << name << ": " << t.colliding << "/" << t.poses << " colliding";
                 break;

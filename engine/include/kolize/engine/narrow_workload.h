@@ -61,12 +61,14 @@ enum class PoseClass {
     kDeep,        ///< centre distance 0.3-0.8 x the touching distance s*
     kShallow,     ///< s* minus 1e-3..1e-2 r: just inside
     kNear,        ///< s* plus a gap of 0.002-0.02 r: just apart
-    kApart,       ///< farther apart, but the root OBBs still overlap
+    kApart,       ///< farther apart (gap > 0.02 r), world AABBs still overlap: a pair the
+                  ///< broadphase hands to the narrowphase
+    kApartObb,    ///< farther apart (gap > 0.02 r), the root OBBs still overlap (harder)
     kCoincident,  ///< a mesh against its own copy at the same pose
     kShifted,     ///< the copy shifted by 2^-8 along x, y or z
 };
 const char* poseClassName(PoseClass kind);
-/// The four random classes, then the two exact-contact ones.
+/// The five random classes, then the two exact-contact ones.
 const std::vector<PoseClass>& allPoseClasses();
 
 struct WorkloadPose {
