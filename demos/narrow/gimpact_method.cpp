@@ -93,7 +93,7 @@ class GImpactMethod : public Method {
         std::sort(seconds.begin(), seconds.end());
         build_.microsPerTriangle = seconds[1] * 1e6 / double(a.mesh->triangleCount());
         build_.nodes = std::size_t(meshA_->shape->getMeshPart(0)->getBoxSet()->getNodeCount());
-        build_.bytesPerNode = double(sizeof(GIM_BVH_TREE_NODE));
+        build_.bytesPerNode = double(sizeof(BT_QUANTIZED_BVH_NODE));  // GImpact quantizes its boxes
         meshB_ = std::make_unique<BulletMesh>(*b.mesh, zeroMargin_);
         objectA_.setCollisionShape(meshA_->shape.get());
         objectB_.setCollisionShape(meshB_->shape.get());

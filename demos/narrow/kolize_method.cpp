@@ -75,8 +75,14 @@ class KolizeMethod : public Method {
   public:
     explicit KolizeMethod(std::string name) : name_(std::move(name)), config_(parse(name_)) {}
     std::string name() const override { return name_; }
+    /// Every configuration answers all-pairs queries; yes/no and contacts (the same
+    /// traversal, one stopping early, one adding geometry) run at leaf sizes 1, 4 and 8.
     bool supports(Mode mode) const override {
-        return config_.variant != "facing" || mode == Mode::kPairs;
+        if (mode == Mode::kPairs) {
+            return true;
+        }
+        return config_.variant != "facing" &&
+               (config_.leaf == 1 || config_.leaf == 4 || config_.leaf == 8);
     }
     void prepare(const workload::WorkloadMesh& a, const workload::WorkloadMesh& b) override {
         const TreeSettings settings{config_.kind, config_.leaf};
