@@ -15,6 +15,8 @@
 #endif
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace kolize::narrowphase::detail {
@@ -81,6 +83,14 @@ struct alignas(16) ObbInFrame {
     float extentSum;
 
     Vec3f axis(int j) const { return Vec3f(bt[0][j], bt[1][j], bt[2][j]); }
+    /// A tag kept in lane 3 of bt[0], which no test reads: the query's stamp of the entry,
+    /// on the same cache line as the data it validates.
+    std::uint32_t tag() const {
+        std::uint32_t t;
+        std::memcpy(&t, &bt[0][3], sizeof t);
+        return t;
+    }
+    void setTag(std::uint32_t t) { std::memcpy(&bt[0][3], &t, sizeof t); }
 };
 
 inline ObbInFrame moveObb(const Obb& b, const Eigen::Matrix3d& r, const Vec3& t) {

@@ -50,9 +50,8 @@ struct QueryScratch::Impl {
     std::uint32_t stamp = 0;
     std::vector<Vec3> vertices;  // B's vertices in A's frame
     std::vector<std::uint32_t> vertexStamp;
-    std::vector<detail::ObbInFrame> obbNodes;  // B's OBB nodes in A's frame
-    std::vector<std::uint32_t> obbStamp;
-    std::vector<Kdop<6>> kdop6;  // B's k-DOP tree refit in A's frame
+    std::vector<detail::ObbInFrame> obbNodes;  // B's OBB nodes in A's frame, tagged by stamp
+    std::vector<Kdop<6>> kdop6;                // B's k-DOP tree refit in A's frame
     std::vector<Kdop<14>> kdop14;
     std::vector<Kdop<18>> kdop18;
     std::vector<Kdop<26>> kdop26;
@@ -62,7 +61,9 @@ struct QueryScratch::Impl {
     std::uint32_t nextStamp() {
         if (++stamp == 0) {  // wrapped: forget every old stamp once every 2^32 queries
             std::fill(vertexStamp.begin(), vertexStamp.end(), 0);
-            std::fill(obbStamp.begin(), obbStamp.end(), 0);
+            for (detail::ObbInFrame& node : obbNodes) {
+                node.setTag(0);
+            }
             stamp = 1;
         }
         return stamp;
@@ -194,9 +195,8 @@ struct ObbOps {
     void prepare() {
         QueryScratch::Impl& s = c.scratch;
         const std::size_t count = c.b.nodeCount();
-        if (s.obbStamp.size() < count) {
-            s.obbStamp.resize(count, 0);
-            s.obbNodes.resize(count);
+        if (s.obbNodes.size() < count) {
+            s.obbNodes.resize(count);  // value-initialized: tag 0, never a live stamp
         }
     }
     void finish() {
@@ -207,11 +207,12 @@ struct ObbOps {
     }
     const detail::ObbInFrame& moved(std::int32_t ib) {
         QueryScratch::Impl& s = c.scratch;
-        if (s.obbStamp[ib] != c.stamp) {
-            s.obbStamp[ib] = c.stamp;
-            s.obbNodes[ib] = detail::moveObb(nb[ib].volume, c.rotation, c.translation);
+        detail::ObbInFrame& entry = s.obbNodes[ib];
+        if (entry.tag() != c.stamp) {
+            entry = detail::moveObb(nb[ib].volume, c.rotation, c.translation);
+            entry.setTag(c.stamp);
         }
-        return s.obbNodes[ib];
+        return entry;
     }
     /// Squared distance of the two nodes' centres, for the yes/no descent order.
     double distance2(std::int32_t ia, std::int32_t ib) {
