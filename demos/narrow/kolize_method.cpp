@@ -24,9 +24,9 @@ const char* modeName(Mode mode) {
 namespace {
 
 /// "kolize-obb-4", optionally with a suffix: "-nosphere" (no sphere stages), "-thesis"
-/// (descent A first, then B), "-front" (restart from the last front: at a repeated pose,
-/// the coherence best case), "-facing" (the thesis's facing-the-motion filter, B moving
-/// towards A).
+/// (descent A first, then B), "-larger" (descend the larger node: FCL's rule), "-front" (restart
+/// from the last front: at a repeated pose, the coherence best case), "-facing" (the thesis's
+/// facing-the-motion filter, B moving towards A).
 struct Config {
     TreeKind kind = TreeKind::kObb;
     int leaf = 4;
@@ -60,9 +60,9 @@ Config parse(const std::string& name) {
     if (dash2 != std::string::npos) {
         c.variant = rest.substr(dash2 + 1);
         if (c.variant != "nosphere" && c.variant != "thesis" && c.variant != "front" &&
-            c.variant != "facing") {
+            c.variant != "facing" && c.variant != "larger") {
             throw std::invalid_argument("unknown variant in '" + name +
-                                        "' (nosphere, thesis, front, facing)");
+                                        "' (nosphere, thesis, larger, front, facing)");
         }
     }
     if (c.leaf < 1 || c.leaf > 8) {
@@ -110,7 +110,9 @@ class KolizeMethod : public Method {
                  : mode == Mode::kPairs ? QueryMode::kAllPairs
                                         : QueryMode::kContacts;
         s.sphere_pretest = config_.variant != "nosphere";
-        s.descent = config_.variant == "thesis" ? Descent::kFirstThenSecond : Descent::kLarger;
+        s.descent = config_.variant == "thesis"   ? Descent::kFirstThenSecond
+                    : config_.variant == "larger" ? Descent::kLarger
+                                                  : Descent::kBoth;
         s.use_front = config_.variant == "front";
         if (config_.variant == "facing") {
             // B moves towards A: its relative motion is from B's centre to A's, in A's frame.
@@ -152,7 +154,7 @@ std::vector<std::string> kolizeMethodNames(bool quick) {
             names.push_back(std::string("kolize-") + treeKindName(k) + "-" + std::to_string(leaf));
         }
     }
-    for (const char* variant : {"nosphere", "thesis", "front", "facing"}) {
+    for (const char* variant : {"nosphere", "thesis", "larger", "front", "facing"}) {
         names.push_back(std::string("kolize-obb-4-") + variant);
     }
     return names;

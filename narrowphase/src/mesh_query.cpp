@@ -364,7 +364,8 @@ void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFr
         stack.push_back(NodePair(0, 0, detail::kNoAxis));
     }
     c.counters.front_size = stack.size();
-    const bool larger = c.settings.descent == Descent::kLarger;
+    const bool larger = c.settings.descent != Descent::kFirstThenSecond;
+    const bool both = c.settings.descent == Descent::kBoth;
     const bool yesNo = c.settings.mode == QueryMode::kYesNo;
     while (!stack.empty()) {
         const NodePair e = stack.back();
@@ -385,6 +386,30 @@ void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFr
             leafPair(c, ta, tb, la, lb);
             if (c.stop) {
                 break;
+            }
+            continue;
+        }
+        if (both && !la.isLeaf() && !lb.isLeaf()) {
+            const std::int32_t a2 = la.right(), b2 = lb.right();
+            NodePair children[4] = {
+                NodePair(ia + 1, ib + 1, detail::kNoAxis), NodePair(ia + 1, b2, detail::kNoAxis),
+                NodePair(a2, ib + 1, detail::kNoAxis), NodePair(a2, b2, detail::kNoAxis)};
+            if constexpr (Ops::kOrdersChildren) {
+                if (yesNo) {  // nearest centres first
+                    double d[4];
+                    for (int k = 0; k < 4; ++k) {
+                        d[k] = ops.distance2(children[k].a(), children[k].b());
+                    }
+                    for (int k = 1; k < 4; ++k) {
+                        for (int m = k; m > 0 && d[m] < d[m - 1]; --m) {
+                            std::swap(d[m], d[m - 1]);
+                            std::swap(children[m], children[m - 1]);
+                        }
+                    }
+                }
+            }
+            for (int k = 3; k >= 0; --k) {
+                stack.push_back(children[k]);
             }
             continue;
         }

@@ -55,7 +55,7 @@ TEST(MeshQuery, DefaultsAreTheDocumentedOnes) {
     const QuerySettings q;
     EXPECT_EQ(q.mode, QueryMode::kAllPairs);
     EXPECT_TRUE(q.sphere_pretest);
-    EXPECT_EQ(q.descent, Descent::kLarger);
+    EXPECT_EQ(q.descent, Descent::kBoth);
     EXPECT_FALSE(q.use_front);
     EXPECT_FALSE(q.facing_filter);
     const TreeSettings t;
@@ -70,7 +70,7 @@ TEST(MeshQuery, EverySettingGivesTheSameAnswer) {
         const auto reference = referencePairs(*s.torus.mesh, p.a, *s.sphere.mesh, p.b);
         ASSERT_FALSE(reference.empty());
         for (bool spheres : {true, false}) {
-            for (Descent descent : {Descent::kLarger, Descent::kFirstThenSecond}) {
+            for (Descent descent : {Descent::kBoth, Descent::kLarger, Descent::kFirstThenSecond}) {
                 QuerySettings settings;
                 settings.sphere_pretest = spheres;
                 settings.descent = descent;

