@@ -287,21 +287,24 @@ void narrowSection(Context& context) {
     }
     const Tally& def = tallies[{kDefault, "pairs"}];
     std::vector<double> apart;
-    for (const std::string& pair : pairs) {
-        const double t = medianTime(csv, pair, "apart", "pairs", kDefault);
-        if (std::isfinite(t)) {
-            apart.push_back(t);
-        }
+    int apartFast = 0;
+    for (std::size_t r : csv.where({{"class", "apart"}, {"mode", "pairs"}, {"method", kDefault}})) {
+        apart.push_back(csv.number(r, "median_us"));
+        apartFast += apart.back() < 0.5;
     }
     const double worstApart = apart.empty() ? kNaN : *std::max_element(apart.begin(), apart.end());
+    const double medianApart = medianOf(apart);
     context.add(
         "\n**Targets** (issue 13; the benchmark, not the tests, checks them):\n\n"
         "- time per query at most 0.5x FCL-OBB (yes/no and all pairs, every class of every "
         "pair): " +
         std::to_string(met) + " of " + std::to_string(total) + " pair x class x mode cells" +
         (notMet.empty() ? "; met everywhere" : "; above it: " + join(notMet, ", ")) +
-        ".\n- apart poses under 0.5 µs: worst pair " + fmt(worstApart) + " µs (" +
-        (worstApart < 0.5 ? "met" : "not met") + ").\n- build at most 1 µs per triangle: " +
+        ".\n- apart poses under 0.5 µs: " + std::to_string(apartFast) + " of " +
+        std::to_string(apart.size()) + " poses (median " + fmt(medianApart) + " µs, worst " +
+        fmt(worstApart) + " µs; " + (worstApart < 0.5 ? "met" : "not met") +
+        ": a pose whose root volumes overlap needs a traversal).\n- build at most 1 µs per "
+        "triangle: " +
         fmt(def.build) + " µs (" + (def.build <= 1 ? "met" : "not met") + ", " +
         csv.at(0, "mesh_a") + ").\n- at most 64 bytes per node: " + fmt(def.bytes) + " (" +
         (def.bytes <= 64 ? "met" : "not met") +
