@@ -79,7 +79,13 @@ class FclMethod : public Method {
             tfA.translation() = poseA_.translation;
             tfB.linear() = poseB_.rotation;
             tfB.translation() = poseB_.translation;
-            if (fcl::detail::initialize(node, *modelA_, tfA, *modelB_, tfB, request_, result)) {
+            // Const arguments select the OBB overload (non-const ones also match FCL's
+            // generic template, an ambiguity GCC warns about).
+            const fcl::BVHModel<BV>& modelA = *modelA_;
+            const fcl::BVHModel<BV>& modelB = *modelB_;
+            const fcl::Transform3d& poseA = tfA;
+            const fcl::Transform3d& poseB = tfB;
+            if (fcl::detail::initialize(node, modelA, poseA, modelB, poseB, request_, result)) {
                 node.enable_statistics = true;
                 fcl::detail::collide(&node);
                 out.bvTests = std::uint64_t(node.num_bv_tests);
