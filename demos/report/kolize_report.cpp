@@ -200,11 +200,12 @@ int main(int argc, char** argv) {
         "in `data/`; every section gives the command that produced its data. Sections: thesis "
         "tables 2.3-2.7, scaling, error against run time (sweeps), the store-only lower bound, "
         "2D against Box2D, then the Bullet worlds from kolize-demo: pair output live and "
-        "replayed, rays, determinism, dynamics accuracy against time, numerical stability.\n");
+        "replayed, rays, determinism, dynamics accuracy against time, numerical stability; then "
+        "the narrowphase (mesh against mesh) against FCL and GImpact.\n");
 
     using Section = void (*)(Context&);
     for (Section section : {thesisSection, scalingSection, sweepSection, lowerBoundSection,
-                            box2dSection, demoSections}) {
+                            box2dSection, demoSections, narrowSection}) {
         section(context);
     }
 

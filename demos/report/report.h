@@ -54,5 +54,6 @@ void sweepSection(Context& context);
 void lowerBoundSection(Context& context);
 void box2dSection(Context& context);
 void demoSections(Context& context);
+void narrowSection(Context& context);
 
 }  // namespace report
