@@ -982,6 +982,11 @@ Roots<N> roots(const Poly<N>& events, const N& a, const N& b) {
             p = deflate(p, b);
             sign_b = signAt(p, b);
         }
+        if (root_at_b) {
+            // Dividing by (t - b), negative on [a, b), flipped the sign at a (issue 15: the
+            // stale sign sent the bisection of an interior root to the wrong end).
+            sign_a = signAt(p, a);
+        }
         if (p.n >= 2) {
             isolateBernstein(p, a, sign_a, b, sign_b, 0, out);
         }

@@ -1,0 +1,83 @@
+// Named regression tests: queries that once broke the robust method, each with what broke.
+// Every contact is checked exactly against the independent reference: hit, and
+// toi <= t* <= toi + toi_tolerance in rationals.
+#include "ccd_exact.h"  // narrowphase/src: the exact decision on its own
+#include "ccd_reference.h"
+
+#include "kolize/narrowphase/ccd.h"
+
+#include <gtest/gtest.h>
+
+namespace {
+
+using namespace kolize::ccd;
+namespace ref = kolize::ccd::reference;
+
+enum class Kind { kVertexFace, kEdgeEdge };
+
+/// The robust method and the exact stage in both arithmetics, at several box budgets and
+/// hand-off tolerances, all find the contact at exactly t_star, never late.
+void expectContactAt(Kind kind, const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
+                     const mpq_class& t_star) {
+    ref::Decision d =
+        kind == Kind::kVertexFace ? ref::vertexFace(start, end) : ref::edgeEdge(start, end);
+    ASSERT_TRUE(d.hit());
+    ASSERT_TRUE(d.atMostEarliest(t_star) && d.atLeastEarliest(t_star)) << "reference disagrees";
+    auto check = [&](bool hit, double toi, double tolerance, const std::string& what) {
+        SCOPED_TRACE(what);
+        ASSERT_TRUE(hit);
+        EXPECT_LE(ref::exact(toi), t_star) << "late: toi " << toi;
+        EXPECT_GE(ref::exact(toi) + ref::exact(tolerance), t_star) << "too early: toi " << toi;
+    };
+    for (int max_boxes : {1, 2, 3, 10, 2000}) {
+        for (double tolerance : {1e-8, 0.1, 1.0}) {
+            RobustSettings s;
+            s.max_boxes = max_boxes;
+            s.tolerance = tolerance;
+            const CcdResult r = kind == Kind::kVertexFace ? vertexFaceRobust({start, end}, s)
+                                                          : edgeEdgeRobust({start, end}, s);
+            check(r.hit, r.toi, s.toi_tolerance,
+                  "robust, max_boxes " + std::to_string(max_boxes) + ", tolerance " +
+                      std::to_string(tolerance));
+        }
+    }
+    for (auto arithmetic : {detail::Arithmetic::kFiltered, detail::Arithmetic::kExactOnly}) {
+        const detail::ExactContact e =
+            kind == Kind::kVertexFace
+                ? detail::vertexFaceExact(start, end, 0.0, 1.0, 1e-6, arithmetic)
+                : detail::edgeEdgeExact(start, end, 0.0, 1.0, 1e-6, arithmetic);
+        check(e.hit, e.toi, 1e-6,
+              arithmetic == detail::Arithmetic::kFiltered ? "exact stage, filtered"
+                                                          : "exact stage, exact only");
+    }
+}
+
+// R1 (issue 15): coplanarity 1.5 (t - 1/3)(t - 1), contact at t* = 1/3 strictly inside the
+// triangle. The double-interval pass divided the root t = 1 out of the polynomial but kept
+// the sign it had at the window's start from before the division, which flipped it: the
+// bisection of the root 1/3 ran to the wrong end and tested the vertex at t ~ 1, a miss.
+TEST(CcdRegression, R1VertexFaceRootAtOneHidesContactAtOneThird) {
+    expectContactAt(
+        Kind::kVertexFace, {Vec3(0.25, 0.5, 0.5), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)},
+        {Vec3(0.25, 0, -0.5), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)}, mpq_class(1, 3));
+}
+
+// R2 (issue 15): the same defect for edge-edge; polynomial 2 (t - 1)(3t - 1)(3t + 1),
+// contact at t* = 1/3, reported as no contact.
+TEST(CcdRegression, R2EdgeEdgeRootAtOneHidesContactAtOneThird) {
+    expectContactAt(
+        Kind::kEdgeEdge, {Vec3(0, 0, 1), Vec3(-1, 1, 0), Vec3(-1, 1, -1), Vec3(1, 1, 0)},
+        {Vec3(1, -1, -1), Vec3(1, 1, -1), Vec3(0, -1, 0), Vec3(-1, 1, 1)}, mpq_class(1, 3));
+}
+
+// R3 (issue 15): roots 9/17 and 1, contact at t* = 9/17. With the flipped sign the root's
+// interval shrank towards t = 1, where the vertex (past the face) is inside again: toi
+// ~0.999999, late; with max_boxes <= 2 the window started at 0 and toi came out as 0.
+TEST(CcdRegression, R3VertexFaceLateToiNearOne) {
+    expectContactAt(Kind::kVertexFace,
+                    {Vec3(0.5, 1, -1), Vec3(-0.5, 1, 1), Vec3(1.5, 1.5, -1), Vec3(-1, -1, -1.5)},
+                    {Vec3(1.5, 2, 1), Vec3(-0.5, 1, 1), Vec3(2.5, 2.5, 1), Vec3(-1.5, 1.5, 1)},
+                    mpq_class(9, 17));
+}
+
+}  // namespace
