@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace kolize::ccd {
@@ -216,6 +218,7 @@ std::array<double, 3> crossAt(const std::array<std::array<double, 3>, 4>& x0,
 struct VertexFaceF {
     static constexpr bool kTriangleDomain = true;
     static constexpr auto kExact = detail::vertexFaceExact;
+    static constexpr const char* kName = "vertexFaceRobust";
     /// Face normal at time t (any direction is valid for exclusion; this one is the
     /// direction in which a near-coplanar F image is thin).
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
@@ -248,6 +251,7 @@ struct VertexFaceF {
 struct EdgeEdgeF {
     static constexpr bool kTriangleDomain = false;
     static constexpr auto kExact = detail::edgeEdgeExact;
+    static constexpr const char* kName = "edgeEdgeRobust";
     /// Common normal of both edges at time t.
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
                                         const std::array<std::array<double, 3>, 4>& dx, double t) {
@@ -299,9 +303,55 @@ bool excludedAlongNormal(std::array<double, 3> n, const Corners& f,
     return lo - bound > 0.0 || hi + bound < 0.0;
 }
 
+/// Smallest effective toi_tolerance: the spacing of doubles just below 1.
+constexpr double kMinToiTolerance = 0x1p-52;
+
+/// Refuses settings without a defined meaning (see RobustSettings) and non-finite input.
+void validate(const char* function, const std::array<Vec3, 4>& start,
+              const std::array<Vec3, 4>& end, const RobustSettings& settings) {
+    auto fail = [&](const std::string& what) {
+        throw std::invalid_argument(std::string(function) + ": " + what);
+    };
+    if (!(settings.toi_tolerance > 0.0)) {
+        fail("RobustSettings::toi_tolerance must be > 0, got " +
+             std::to_string(settings.toi_tolerance));
+    }
+    if (std::isnan(settings.min_time) || std::isnan(settings.max_time)) {
+        fail("RobustSettings::min_time and max_time must not be NaN");
+    }
+    for (int side = 0; side < 2; ++side) {
+        for (int i = 0; i < 4; ++i) {
+            const Vec3& p = side ? end[i] : start[i];
+            if (!p.allFinite()) {
+                fail(std::string(side ? "end" : "start") + "[" + std::to_string(i) +
+                     "] is not finite");
+            }
+        }
+    }
+}
+
 template <class Evaluator>
 CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                     const RobustSettings& settings) {
+    validate(Evaluator::kName, start, end, settings);
+    CcdResult result;
+    const double t_max = std::clamp(settings.max_time, 0.0, 1.0);
+    const double t_min = std::clamp(settings.min_time, 0.0, 1.0);
+    if (t_min > t_max) {
+        return result;  // Empty range.
+    }
+    // Half the tolerance for the exact stage, whose toi is one rounding below its bracket:
+    // t* <= toi + 2^-53 + tolerance / 2 <= toi + tolerance.
+    // (At most 1: any wider bracket of a time in [0, 1] is as good, and stays finite.)
+    const double exact_tolerance =
+        std::min(0.5 * std::max(settings.toi_tolerance, kMinToiTolerance), 1.0);
+    if (settings.arithmetic == RobustArithmetic::kExactOnly) {
+        const detail::ExactContact exact = Evaluator::kExact(
+            start, end, t_min, t_max, exact_tolerance, detail::Arithmetic::kExactOnly);
+        result.hit = exact.hit;
+        result.toi = exact.hit ? exact.toi : 1.0;
+        return result;
+    }
     std::array<std::array<double, 3>, 4> x0{}, dx{};
     std::array<double, 3> eps{};
     for (int k = 0; k < 3; ++k) {
@@ -315,9 +365,6 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     }
 
     const Evaluator evaluate;
-    CcdResult result;
-    const double t_max = std::clamp(settings.max_time, 0.0, 1.0);
-    const double t_min = std::clamp(settings.min_time, 0.0, t_max);
     std::priority_queue<Box, std::vector<Box>, LaterBox> queue;
     // Any double t is evaluated exactly as given, and a rounded midpoint still lies in
     // [t0, t1], so boxes keep covering [min_time, max_time] without dyadic end points.
@@ -326,8 +373,8 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     // Boxes are examined in order of t0 and every box before was excluded, so no contact
     // happens before t0: the exact decision only needs [t0, max_time].
     auto decideExactly = [&](double t0) {
-        const detail::ExactContact exact = Evaluator::kExact(
-            start, end, t0, t_max, settings.toi_tolerance, detail::Arithmetic::kFiltered);
+        const detail::ExactContact exact = Evaluator::kExact(start, end, t0, t_max, exact_tolerance,
+                                                             detail::Arithmetic::kFiltered);
         result.hit = exact.hit;
         result.toi = exact.hit ? exact.toi : 1.0;
         return result;

@@ -1312,6 +1312,8 @@ template <class N>
 ExactContact vertexFaceExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                              double t_lo, double t_hi, double toi_tolerance,
                              Arithmetic arithmetic) {
+    assert(0.0 < toi_tolerance && toi_tolerance <= 1.0 && 0.0 <= t_lo && t_lo <= t_hi &&
+           t_hi <= 1.0);
     // Both passes need upward rounding (the exact one filters with intervals too); they are
     // not inlined, so no floating-point operation can move across the mode switch.
     const UpwardRounding upward;
@@ -1326,6 +1328,8 @@ ExactContact vertexFaceExact(const std::array<Vec3, 4>& start, const std::array<
 
 ExactContact edgeEdgeExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                            double t_lo, double t_hi, double toi_tolerance, Arithmetic arithmetic) {
+    assert(0.0 < toi_tolerance && toi_tolerance <= 1.0 && 0.0 <= t_lo && t_lo <= t_hi &&
+           t_hi <= 1.0);
     const UpwardRounding upward;
     if (arithmetic == Arithmetic::kFiltered) {
         try {

@@ -8,6 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
 namespace {
 
 using namespace kolize::ccd;
@@ -78,6 +82,75 @@ TEST(CcdRegression, R3VertexFaceLateToiNearOne) {
                     {Vec3(0.5, 1, -1), Vec3(-0.5, 1, 1), Vec3(1.5, 1.5, -1), Vec3(-1, -1, -1.5)},
                     {Vec3(1.5, 2, 1), Vec3(-0.5, 1, 1), Vec3(2.5, 2.5, 1), Vec3(-1.5, 1.5, 1)},
                     mpq_class(9, 17));
+}
+
+}  // namespace
+
+namespace {
+
+/// The irrational contact of ccd_reference_test.cpp: t* = 1/sqrt 2.
+const VertexFaceQuery kIrrational{{Vec3(0.25, 0, 1), Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 4, 0)},
+                                  {Vec3(0.25, 2, 1), Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 4, 4)}};
+
+// Issue 15: toi_tolerance <= 0 never returned when the first contact time is irrational (the
+// bracket was halved forever); a NaN min_time or max_time silently answered "no contact".
+// Both are refused now, with the setting's name in the message.
+TEST(CcdRegression, BadSettingsAreRefusedNotHungOrIgnored) {
+    for (double bad : {0.0, -1e-6, std::nan("")}) {
+        RobustSettings s;
+        s.toi_tolerance = bad;
+        EXPECT_THROW(vertexFaceRobust(kIrrational, s), std::invalid_argument) << bad;
+        EXPECT_THROW(edgeEdgeRobust({kIrrational.start, kIrrational.end}, s),
+                     std::invalid_argument);
+    }
+    for (int which = 0; which < 2; ++which) {
+        RobustSettings s;
+        (which ? s.max_time : s.min_time) = std::nan("");
+        try {
+            vertexFaceRobust(kIrrational, s);
+            ADD_FAILURE() << "NaN time bound accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("min_time"), std::string::npos) << e.what();
+        }
+    }
+    VertexFaceQuery nan_point = kIrrational;
+    nan_point.end[2].y() = std::nan("");
+    EXPECT_THROW(vertexFaceRobust(nan_point), std::invalid_argument);
+    nan_point.end[2].y() = INFINITY;
+    EXPECT_THROW(vertexFaceRobust(nan_point), std::invalid_argument);
+}
+
+// The smallest tolerances still return, and still bracket the irrational contact exactly:
+// below 2^-52 the tolerance acts as 2^-52 (toi is a double).
+TEST(CcdRegression, TinyToiToleranceBracketsAnIrrationalContact) {
+    for (double tolerance : {1e-300, 0x1p-52, 1e-12, 1e-6, double(INFINITY)}) {
+        for (auto arithmetic : {RobustArithmetic::kFiltered, RobustArithmetic::kExactOnly}) {
+            RobustSettings s;
+            s.toi_tolerance = tolerance;
+            s.arithmetic = arithmetic;
+            const CcdResult r = vertexFaceRobust(kIrrational, s);
+            ref::Decision d = ref::vertexFace(kIrrational.start, kIrrational.end);
+            ASSERT_TRUE(r.hit);
+            EXPECT_TRUE(d.atMostEarliest(ref::exact(r.toi))) << tolerance;
+            if (std::isfinite(tolerance)) {
+                EXPECT_TRUE(
+                    d.atLeastEarliest(ref::exact(r.toi) + ref::exact(std::max(tolerance, 0x1p-52))))
+                    << tolerance << " toi " << r.toi;
+            }
+        }
+    }
+}
+
+TEST(CcdRegression, EmptyAndClampedTimeRanges) {
+    RobustSettings s;
+    s.min_time = 0.8;
+    s.max_time = 0.7;  // empty
+    EXPECT_FALSE(vertexFaceRobust(kIrrational, s).hit);
+    s.min_time = -5;
+    s.max_time = 7;  // clamped to [0, 1]
+    const CcdResult r = vertexFaceRobust(kIrrational, s);
+    EXPECT_TRUE(r.hit);
+    EXPECT_NEAR(r.toi, std::sqrt(0.5), 1e-6);
 }
 
 }  // namespace

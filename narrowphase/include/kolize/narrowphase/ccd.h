@@ -106,8 +106,20 @@ struct CubicSettings {
     double tolerance = 1e-6;
 };
 
+/// How `robust` computes. Every mode gives the same answers (the guarantee above); they
+/// differ in cost only, and the tests check that they agree.
+enum class RobustArithmetic {
+    /// Default: the floating-point stages, then the exact stage where they cannot decide.
+    kFiltered,
+    /// No floating-point stage: the exact stage alone, on exact numbers only (no interval
+    /// filter), over the whole range. Slow; for tests and measurements.
+    kExactOnly,
+};
+
 /// Settings of the exact method (`robust`). None of them changes whether a contact is
-/// reported; `tolerance` and `max_boxes` only move work between the two stages.
+/// reported; `tolerance`, `max_boxes` and `arithmetic` only move work between the stages.
+/// `robust` throws std::invalid_argument when `toi_tolerance` is not > 0 (NaN included)
+/// or `min_time` or `max_time` is NaN.
 struct RobustSettings {
     /// Hand-off point of the floating-point stage: a box it cannot exclude goes to the exact
     /// stage once its F range is at most `tolerance` times the F range over the whole
@@ -116,17 +128,21 @@ struct RobustSettings {
     /// benchmark (`kolize-ccd-bench --sweep` runs 1e-8 ... 1e-1).
     double tolerance = 0.1;
     /// The reported `toi` is at most this much earlier than the true first contact (and
-    /// never later).
+    /// never later). Must be > 0 (infinity is allowed: any toi no later than the contact);
+    /// values below 2^-52 (the spacing of doubles just below 1) act as 2^-52, since toi is
+    /// a double.
     double toi_tolerance = 1e-6;
-    /// Only contacts at t in [min_time, max_time] (within [0, 1]) are searched: the
-    /// guarantees hold on that range, contacts outside it are ignored. Lets a caller that
-    /// already knows an earlier contact, or splits the step into time slices (meshCcd),
-    /// skip work.
+    /// Only contacts at t in [min_time, max_time] are searched: the guarantees hold on that
+    /// range, contacts outside it are ignored. Lets a caller that already knows an earlier
+    /// contact, or splits the step into time slices (meshCcd), skip work. Both are clamped
+    /// to [0, 1]; min_time > max_time is an empty range (no contact); NaN is refused.
     double min_time = 0.0;
     double max_time = 1.0;
     /// Box budget of the floating-point stage; when it runs out the exact stage decides.
     /// Bounds the stage's worst-case work; never changes the answer.
     int max_boxes = 2000;
+    /// Which stages compute (see RobustArithmetic); never changes the answer.
+    RobustArithmetic arithmetic = RobustArithmetic::kFiltered;
 };
 
 /// Thesis baseline: vertex-face CCD via the coplanarity cubic. May miss collisions.
