@@ -203,6 +203,13 @@ std::vector<Algebraic> roots(const Poly& p, const mpq_class& a, const mpq_class&
     if (p.degree() <= 0 || a > b) {
         return out;
     }
+    if (p.degree() == 1) {  // one rational root
+        const mpq_class r = -p.c[0] / p.c[1];
+        if (a <= r && r <= b) {
+            out.push_back(rationalRoot(r));
+        }
+        return out;
+    }
     const Poly q = squarefree(p);
     if (signAtRational(q, a) == 0) {
         out.push_back(rationalRoot(a));
@@ -377,9 +384,32 @@ Decision decide(const std::array<PolyVec, 4>& x, const mpq_class& t_min, const m
         candidates.push_back(rationalRoot(t_min));
         SignTest collect;
         inside(collect, x);
-        for (const Poly& p : collect.listed()) {
+        // Many listed polynomials agree up to a factor (components of the same products):
+        // their roots are isolated once, and a rational candidate is tested once.
+        std::vector<Poly> distinct;
+        for (Poly p : collect.listed()) {
+            if (p.degree() <= 0) {
+                continue;
+            }
+            const mpq_class lead = p.c.back();
+            for (mpq_class& c : p.c) {
+                c /= lead;
+            }
+            if (std::none_of(distinct.begin(), distinct.end(),
+                             [&](const Poly& o) { return o.c == p.c; })) {
+                distinct.push_back(std::move(p));
+            }
+        }
+        for (const Poly& p : distinct) {
             for (Algebraic& r : roots(p, t_min, t_max)) {
-                candidates.push_back(std::move(r));
+                const bool repeated =
+                    r.rational &&
+                    std::any_of(candidates.begin(), candidates.end(), [&](const Algebraic& o) {
+                        return o.rational && o.value == r.value;
+                    });
+                if (!repeated) {
+                    candidates.push_back(std::move(r));
+                }
             }
         }
     }
