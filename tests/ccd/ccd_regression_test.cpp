@@ -84,6 +84,21 @@ TEST(CcdRegression, R3VertexFaceLateToiNearOne) {
                     mpq_class(9, 17));
 }
 
+// Found by kolize-ccd-soak (seed 2, query 80690, near-miss-ulps): edge B's ends are 1 ulp off
+// grid points, so the coplanarity polynomial has nearly cancelling coefficients. The interval
+// pass's linear root num / den came out as the wide interval [4/15, 3/5] around the contact
+// at t* ~ 0.4 (exactly 2702159776422297 / 6755399441055743); exact times were never refined,
+// so toi = 4/15 was reported, far too early.
+TEST(CcdRegression, IntervalLinearRootWiderThanTheTolerance) {
+    expectContactAt(
+        Kind::kEdgeEdge,
+        {Vec3(0, 0x1p-1, 0x1.8p+0), Vec3(0, 0x1.fffffffffffffp+0, 0x1p+1),
+         Vec3(0x1p-1, 0x1.4p+0, 0x1.6000000000001p+0), Vec3(-0x1.8p+0, 0x1.6p+1, 0x1.bp+1)},
+        {Vec3(0, 0x1p-1, 0x1.8p+0), Vec3(0, 0x1.fffffffffffffp+0, 0x1p+1),
+         Vec3(0x1p-1, 0x1.4p+0, 0x1.6p+0), Vec3(-0x1.8p+0, 0x1.6p+1, 0x1.affffffffffffp+1)},
+        mpq_class("2702159776422297/6755399441055743"));
+}
+
 }  // namespace
 
 namespace {
