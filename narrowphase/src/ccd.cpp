@@ -1,5 +1,6 @@
 #include "kolize/narrowphase/ccd.h"
 
+#include "ccd_certified.h"
 #include "ccd_exact.h"
 
 #include <Eigen/Geometry>
@@ -218,6 +219,7 @@ std::array<double, 3> crossAt(const std::array<std::array<double, 3>, 4>& x0,
 struct VertexFaceF {
     static constexpr bool kTriangleDomain = true;
     static constexpr auto kExact = detail::vertexFaceExact;
+    static constexpr auto kCertified = detail::vertexFaceCertified;
     static constexpr const char* kName = "vertexFaceRobust";
     /// Face normal at time t (any direction is valid for exclusion; this one is the
     /// direction in which a near-coplanar F image is thin).
@@ -251,6 +253,7 @@ struct VertexFaceF {
 struct EdgeEdgeF {
     static constexpr bool kTriangleDomain = false;
     static constexpr auto kExact = detail::edgeEdgeExact;
+    static constexpr auto kCertified = detail::edgeEdgeCertified;
     static constexpr const char* kName = "edgeEdgeRobust";
     /// Common normal of both edges at time t.
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
@@ -350,7 +353,22 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             start, end, t_min, t_max, exact_tolerance, detail::Arithmetic::kExactOnly);
         result.hit = exact.hit;
         result.toi = exact.hit ? exact.toi : 1.0;
+        result.decided_exactly = true;
         return result;
+    }
+    double t_from = t_min;  // no contact before t_from
+    if (settings.arithmetic == RobustArithmetic::kCertified) {
+        const detail::CertifiedOutcome certified = Evaluator::kCertified(
+            start, end, t_min, t_max, std::max(settings.toi_tolerance, kMinToiTolerance));
+        if (certified.verdict == detail::CertifiedOutcome::Verdict::kNoContact) {
+            return result;
+        }
+        if (certified.verdict == detail::CertifiedOutcome::Verdict::kContact) {
+            result.hit = true;
+            result.toi = certified.toi;
+            return result;
+        }
+        t_from = certified.resume_from;
     }
     std::array<std::array<double, 3>, 4> x0{}, dx{};
     std::array<double, 3> eps{};
@@ -368,7 +386,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     std::priority_queue<Box, std::vector<Box>, LaterBox> queue;
     // Any double t is evaluated exactly as given, and a rounded midpoint still lies in
     // [t0, t1], so boxes keep covering [min_time, max_time] without dyadic end points.
-    queue.push({t_min, t_max, 0.0, 1.0, 0.0, 1.0, 0});
+    queue.push({t_from, t_max, 0.0, 1.0, 0.0, 1.0, 0});
     Corners f;
     // Boxes are examined in order of t0 and every box before was excluded, so no contact
     // happens before t0: the exact decision only needs [t0, max_time].
@@ -377,6 +395,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
                                                              detail::Arithmetic::kFiltered);
         result.hit = exact.hit;
         result.toi = exact.hit ? exact.toi : 1.0;
+        result.decided_exactly = true;
         return result;
     };
     double handoff_width = -1.0;  // set from the first (whole-domain) box

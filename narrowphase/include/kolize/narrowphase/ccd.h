@@ -95,6 +95,8 @@ struct CcdResult {
     /// 2^-45 resolution limit) and left the decision to the exact stage early. The answer
     /// is exact either way; this only explains the cost.
     bool budget_exhausted = false;
+    /// Robust method only: the exact stage decided (the floating-point stages could not).
+    bool decided_exactly = false;
 };
 
 /// Settings of the thesis baseline (`cubic`).
@@ -109,8 +111,12 @@ struct CubicSettings {
 /// How `robust` computes. Every mode gives the same answers (the guarantee above); they
 /// differ in cost only, and the tests check that they agree.
 enum class RobustArithmetic {
-    /// Default: the floating-point stages, then the exact stage where they cannot decide.
-    kFiltered,
+    /// Default: the certified floating-point decision, then (where it cannot decide) the
+    /// inclusion search and the exact stage.
+    kCertified,
+    /// Without the certified decision: the inclusion search excludes, the exact stage
+    /// decides everything else (double intervals first, GMP where they cannot).
+    kSearchThenExact,
     /// No floating-point stage: the exact stage alone, on exact numbers only (no interval
     /// filter), over the whole range. Slow; for tests and measurements.
     kExactOnly,
@@ -142,7 +148,7 @@ struct RobustSettings {
     /// Bounds the stage's worst-case work; never changes the answer.
     int max_boxes = 2000;
     /// Which stages compute (see RobustArithmetic); never changes the answer.
-    RobustArithmetic arithmetic = RobustArithmetic::kFiltered;
+    RobustArithmetic arithmetic = RobustArithmetic::kCertified;
 };
 
 /// Thesis baseline: vertex-face CCD via the coplanarity cubic. May miss collisions.
