@@ -34,6 +34,9 @@ class Random {
     double half(int range = 2) { return 0.5 * uniform(-2 * range, 2 * range); }
     Vec3 halves(int range = 2) { return Vec3(half(range), half(range), half(range)); }
     Vec3 unitGrid() { return Vec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)); }
+    /// A double in [0, 1) with a full mantissa, and one in [-1, 1).
+    double unit() { return std::uniform_real_distribution<double>(0.0, 1.0)(rng_); }
+    double real() { return 2.0 * unit() - 1.0; }
 
   private:
     std::mt19937_64 rng_;
@@ -233,6 +236,53 @@ void hourglass(Random& r, Query& q, double tc) {
     }
 }
 
+/// Uniform doubles with full mantissas: contacts and misses the floating-point stage can
+/// mostly certify.
+void generic(Random& r, Query& q) {
+    auto point = [&] { return Vec3(r.real(), r.real(), r.real()); };
+    for (Vec3& p : q.start) {
+        p = point();
+    }
+    for (int i = 0; i < 4; ++i) {
+        q.end[i] = r.chance(25) ? q.start[i] : Vec3(q.start[i] + 0.75 * point());
+    }
+}
+
+/// A generic contact at a random time, then moved off it by a relative distance from 1e-6
+/// down to 1e-17 (or not at all): the floating-point stage's certificates at their limits.
+void genericNear(Random& r, Query& q) {
+    const double tc = r.unit();
+    Points contact;
+    for (Vec3& p : contact) {
+        p = Vec3(r.real(), r.real(), r.real());
+    }
+    if (q.kind == Kind::kVertexFace) {
+        double u = r.unit(), v = r.unit();
+        if (u + v > 1) {
+            u = 1 - u;
+            v = 1 - v;
+        }
+        if (r.chance(20)) {
+            v = r.chance(50) ? 0.0 : 1.0 - u;  // on an edge
+        }
+        contact[0] = contact[1] + u * (contact[2] - contact[1]) + v * (contact[3] - contact[1]);
+    } else {
+        const double s = r.chance(20) ? 0.0 : r.unit(), w = r.unit();
+        const Vec3 x = contact[0] + s * (contact[1] - contact[0]);
+        const Vec3 d = contact[3] - contact[2];
+        contact[2] = x - w * d;
+        contact[3] = x + (1 - w) * d;
+    }
+    const double distance =
+        r.pick(std::vector<double>{0, 1e-6, 1e-9, 1e-12, 1e-14, 1e-15, 1e-16, 1e-17});
+    contact[0] += distance * Vec3(r.real(), r.real(), r.real());
+    for (int i = 0; i < 4; ++i) {
+        const Vec3 v = r.chance(25) ? Vec3::Zero() : Vec3(r.real(), r.real(), r.real());
+        q.start[i] = contact[i] - tc * v;
+        q.end[i] = q.start[i] + v;
+    }
+}
+
 /// A random symmetry of the grid (axis permutation and sign flips): exact.
 void permuteAxes(Random& r, Query& q) {
     std::array<int, 3> axis{0, 1, 2};
@@ -257,21 +307,23 @@ void scaleBy(Query& q, int exponent) {
     }
 }
 
-RobustSettings withExactHandOff() {
+RobustSettings withArithmetic(RobustArithmetic arithmetic) {
     RobustSettings s;
+    s.arithmetic = arithmetic;
+    return s;
+}
+
+/// The inclusion search hands its first box to the exact stage.
+RobustSettings withExactHandOff(RobustArithmetic arithmetic) {
+    RobustSettings s = withArithmetic(arithmetic);
     s.max_boxes = 1;
     return s;
 }
 
+/// The inclusion search goes deep before the exact stage.
 RobustSettings withFineSearch() {
-    RobustSettings s;
+    RobustSettings s = withArithmetic(RobustArithmetic::kSearchThenExact);
     s.tolerance = 1e-8;
-    return s;
-}
-
-RobustSettings exactOnly() {
-    RobustSettings s;
-    s.arithmetic = RobustArithmetic::kExactOnly;
     return s;
 }
 
@@ -279,9 +331,9 @@ RobustSettings exactOnly() {
 
 const std::vector<std::string>& familyNames() {
     static const std::vector<std::string> kNames{
-        "grid-halves",  "grid-unit",      "coplanar-motion", "parallel-at-end",
-        "touch-at-k/8", "zero-motion",    "near-miss-ulps",  "tangential-double-root",
-        "hourglass",    "touch-at-0-or-1"};
+        "grid-halves",  "grid-unit",       "coplanar-motion", "parallel-at-end",
+        "touch-at-k/8", "zero-motion",     "near-miss-ulps",  "tangential-double-root",
+        "hourglass",    "touch-at-0-or-1", "generic",         "generic-near"};
     return kNames;
 }
 
@@ -323,8 +375,14 @@ Query generate(uint64_t seed, uint64_t index, int family) {
         case 8:
             hourglass(r, q, eighth(r));
             break;
-        default:
+        case 9:
             touchAt(r, q, r.chance(50) ? 0.0 : 1.0, false);
+            break;
+        case 10:
+            generic(r, q);
+            break;
+        default:
+            genericNear(r, q);
             break;
     }
     permuteAxes(r, q);
@@ -357,10 +415,13 @@ Query generate(uint64_t seed, uint64_t index, int family) {
 }
 
 const std::vector<Mode>& modes() {
-    static const std::vector<Mode> kModes{{"filtered", RobustSettings{}},
-                                          {"filtered-exact-hand-off", withExactHandOff()},
-                                          {"filtered-fine-search", withFineSearch()},
-                                          {"exact-only", exactOnly()}};
+    static const std::vector<Mode> kModes{
+        {"certified", RobustSettings{}},
+        {"certified-exact-hand-off", withExactHandOff(RobustArithmetic::kCertified)},
+        {"search-then-exact", withArithmetic(RobustArithmetic::kSearchThenExact)},
+        {"search-exact-hand-off", withExactHandOff(RobustArithmetic::kSearchThenExact)},
+        {"search-fine", withFineSearch()},
+        {"exact-only", withArithmetic(RobustArithmetic::kExactOnly)}};
     return kModes;
 }
 
@@ -374,12 +435,16 @@ reference::Decision decide(const Query& q) {
                                        : ref::edgeEdge(q.start, q.end, lo, hi);
 }
 
-std::optional<std::string> check(const Query& q, const Mode& mode, reference::Decision& d) {
+std::optional<std::string> check(const Query& q, const Mode& mode, reference::Decision& d,
+                                 CcdResult* result) {
     RobustSettings s = mode.settings;
     s.min_time = q.min_time;
     s.max_time = q.max_time;
     const CcdResult r = q.kind == Kind::kVertexFace ? vertexFaceRobust({q.start, q.end}, s)
                                                     : edgeEdgeRobust({q.start, q.end}, s);
+    if (result) {
+        *result = r;
+    }
     char buffer[200];
     if (r.hit != d.hit()) {
         std::snprintf(buffer, sizeof buffer, "%s (reference: %s)",

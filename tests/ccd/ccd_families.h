@@ -41,7 +41,8 @@ const std::vector<Mode>& modes();
 /// Runs `robust` on q in the given mode and checks it against the reference decision d:
 /// hit must agree, and when both hit, toi <= t* <= toi + toi_tolerance exactly. Returns a
 /// description of the disagreement, or nothing.
-std::optional<std::string> check(const Query& q, const Mode& mode, reference::Decision& d);
+std::optional<std::string> check(const Query& q, const Mode& mode, reference::Decision& d,
+                                 CcdResult* result = nullptr);
 
 /// The reference decision of q over its time range.
 reference::Decision decide(const Query& q);

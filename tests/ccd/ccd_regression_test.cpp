@@ -139,7 +139,8 @@ TEST(CcdRegression, BadSettingsAreRefusedNotHungOrIgnored) {
 // below 2^-52 the tolerance acts as 2^-52 (toi is a double).
 TEST(CcdRegression, TinyToiToleranceBracketsAnIrrationalContact) {
     for (double tolerance : {1e-300, 0x1p-52, 1e-12, 1e-6, double(INFINITY)}) {
-        for (auto arithmetic : {RobustArithmetic::kFiltered, RobustArithmetic::kExactOnly}) {
+        for (auto arithmetic : {RobustArithmetic::kCertified, RobustArithmetic::kSearchThenExact,
+                                RobustArithmetic::kExactOnly}) {
             RobustSettings s;
             s.toi_tolerance = tolerance;
             s.arithmetic = arithmetic;

@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     const auto& names = families::familyNames();
     const auto& modes = families::modes();
     struct Count {
-        uint64_t queries = 0, hits = 0, disagreements = 0;
+        uint64_t queries = 0, hits = 0, disagreements = 0, exact = 0;
         double reference_seconds = 0, robust_seconds = 0;
     };
     std::vector<std::vector<Count>> counts(names.size(), std::vector<Count>(modes.size()));
@@ -67,7 +67,9 @@ int main(int argc, char** argv) {
             c.hits += d.hit();
             c.reference_seconds += reference_seconds;
             const auto m0 = std::chrono::steady_clock::now();
-            const auto failure = families::check(q, modes[m], d);
+            CcdResult result;
+            const auto failure = families::check(q, modes[m], d, &result);
+            c.exact += result.decided_exactly;
             c.robust_seconds +=
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
             if (!failure) {
@@ -90,18 +92,18 @@ int main(int argc, char** argv) {
     }
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("\n%-24s %-26s %10s %10s %13s %9s %9s\n", "family", "mode", "queries", "contacts",
-                "disagreements", "ref_us", "check_us");
+    std::printf("\n%-24s %-26s %10s %10s %13s %7s %9s %9s\n", "family", "mode", "queries",
+                "contacts", "disagreements", "exact%", "ref_us", "check_us");
     for (size_t f = 0; f < names.size(); ++f) {
         for (size_t m = 0; m < modes.size(); ++m) {
             const Count& c = counts[f][m];
             if (c.queries) {
-                std::printf("%-24s %-26s %10llu %10llu %13llu %9.1f %9.1f\n", names[f].c_str(),
-                            modes[m].name.c_str(), static_cast<unsigned long long>(c.queries),
-                            static_cast<unsigned long long>(c.hits),
-                            static_cast<unsigned long long>(c.disagreements),
-                            1e6 * c.reference_seconds / c.queries,
-                            1e6 * c.robust_seconds / c.queries);
+                std::printf(
+                    "%-24s %-26s %10llu %10llu %13llu %7.1f %9.1f %9.1f\n", names[f].c_str(),
+                    modes[m].name.c_str(), static_cast<unsigned long long>(c.queries),
+                    static_cast<unsigned long long>(c.hits),
+                    static_cast<unsigned long long>(c.disagreements), 100.0 * c.exact / c.queries,
+                    1e6 * c.reference_seconds / c.queries, 1e6 * c.robust_seconds / c.queries);
             }
         }
     }
