@@ -506,11 +506,19 @@ CcdResult edgeEdgeCubic(const EdgeEdgeQuery& q, const CubicSettings& settings) {
 }
 
 CcdResult vertexFaceRobust(const VertexFaceQuery& q, const RobustSettings& settings) {
-    return robustCcd<VertexFaceF>(q.start, q.end, settings);
+    const CcdResult r = robustCcd<VertexFaceF>(q.start, q.end, settings);
+    if (settings.observer) {
+        settings.observer->observe(false, q.start, q.end, settings, r);
+    }
+    return r;
 }
 
 CcdResult edgeEdgeRobust(const EdgeEdgeQuery& q, const RobustSettings& settings) {
-    return robustCcd<EdgeEdgeF>(q.start, q.end, settings);
+    const CcdResult r = robustCcd<EdgeEdgeF>(q.start, q.end, settings);
+    if (settings.observer) {
+        settings.observer->observe(true, q.start, q.end, settings, r);
+    }
+    return r;
 }
 
 }  // namespace kolize::ccd

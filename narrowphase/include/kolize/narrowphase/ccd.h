@@ -122,6 +122,20 @@ enum class RobustArithmetic {
     kExactOnly,
 };
 
+struct RobustSettings;
+
+/// Sees every query the robust method answers (with its settings, e.g. the time range a
+/// caller such as meshCcd searched, and the answer): lets a tool record the queries of a
+/// real run as benchmark data (kolize-ccd-record). Called on the calling thread, after the
+/// answer is computed.
+class QueryObserver {
+  public:
+    virtual ~QueryObserver() = default;
+    virtual void observe(bool edge_edge, const std::array<Vec3, 4>& start,
+                         const std::array<Vec3, 4>& end, const RobustSettings& settings,
+                         const CcdResult& result) = 0;
+};
+
 /// Settings of the exact method (`robust`). None of them changes whether a contact is
 /// reported; `tolerance`, `max_boxes` and `arithmetic` only move work between the stages.
 /// `robust` throws std::invalid_argument when `toi_tolerance` is not > 0 (NaN included)
@@ -149,6 +163,8 @@ struct RobustSettings {
     int max_boxes = 2000;
     /// Which stages compute (see RobustArithmetic); never changes the answer.
     RobustArithmetic arithmetic = RobustArithmetic::kCertified;
+    /// When set, sees every query and its answer (see QueryObserver); not owned.
+    QueryObserver* observer = nullptr;
 };
 
 /// Thesis baseline: vertex-face CCD via the coplanarity cubic. May miss collisions.
