@@ -1,4 +1,5 @@
 /// kolize-ccd-soak [--queries N] [--seed S] [--first I] [--family F] [--shrink K]
+/// kolize-ccd-soak --data DIR
 ///
 /// Differential soak of the robust CCD method against the exact reference (ccd_reference.h):
 /// N queries (default 1 000 000) from the seeded degenerate families of ccd_families.h,
@@ -8,7 +9,13 @@
 /// and mode (rerun it alone with --first I --queries 1); the first K (default 3) are also
 /// shrunk and printed as source text. Ends with a table per family and mode; exit status 1
 /// if anything disagreed.
+///
+/// With --data, checks a query folder in the Sample-Queries layout instead (the shipped data
+/// set, or one written by kolize-ccd-record): every label against the reference, and every
+/// mode of `robust` against the reference as above.
 #include "ccd_families.h"
+
+#include "kolize/narrowphase/ccd_dataset.h"
 
 #include <chrono>
 #include <cstdio>
@@ -18,7 +25,62 @@
 
 using namespace kolize::ccd;
 
+namespace {
+
+int checkData(const std::string& dir) {
+    const auto& modes = families::modes();
+    uint64_t total = 0, label_errors = 0, disagreements = 0;
+    std::printf("%-34s %-11s %8s %8s %7s %13s\n", "data set", "kind", "queries", "contacts",
+                "labels", "disagreements");
+    for (const QuerySet& set : readQueryFolder(dir)) {
+        uint64_t hits = 0, labels = 0, wrong = 0;
+        for (size_t i = 0; i < set.queries.size(); ++i) {
+            families::Query q;
+            q.kind = set.kind == QueryKind::kVertexFace ? families::Kind::kVertexFace
+                                                        : families::Kind::kEdgeEdge;
+            q.start = set.queries[i].start;
+            q.end = set.queries[i].end;
+            reference::Decision d = families::decide(q);
+            hits += d.hit();
+            if (d.hit() != set.queries[i].collides) {
+                ++labels;
+                std::printf("LABEL %s %s #%zu: file says %d, reference %d\n", set.scene.c_str(),
+                            kindName(set.kind), i, set.queries[i].collides, d.hit());
+            }
+            for (const families::Mode& mode : modes) {
+                if (const auto failure = families::check(q, mode, d)) {
+                    ++wrong;
+                    std::printf("DISAGREEMENT %s %s #%zu mode %s: %s\n", set.scene.c_str(),
+                                kindName(set.kind), i, mode.name.c_str(), failure->c_str());
+                }
+            }
+        }
+        std::printf("%-34s %-11s %8zu %8llu %7llu %13llu\n", set.scene.c_str(), kindName(set.kind),
+                    set.queries.size(), static_cast<unsigned long long>(hits),
+                    static_cast<unsigned long long>(labels),
+                    static_cast<unsigned long long>(wrong));
+        total += set.queries.size();
+        label_errors += labels;
+        disagreements += wrong;
+    }
+    std::printf("\n%s: %llu queries, %zu modes each: %llu wrong labels, %llu disagreements\n",
+                dir.c_str(), static_cast<unsigned long long>(total), modes.size(),
+                static_cast<unsigned long long>(label_errors),
+                static_cast<unsigned long long>(disagreements));
+    return label_errors || disagreements ? 1 : 0;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+    if (argc == 3 && std::string(argv[1]) == "--data") {
+        try {
+            return checkData(argv[2]);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "kolize-ccd-soak: %s\n", e.what());
+            return 2;
+        }
+    }
     uint64_t queries = 1000000, seed = 1, first = 0;
     int family = -1, shrink_budget = 3;
     for (int i = 1; i + 1 < argc; i += 2) {
