@@ -348,27 +348,37 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     // (At most 1: any wider bracket of a time in [0, 1] is as good, and stays finite.)
     const double exact_tolerance =
         std::min(0.5 * std::max(settings.toi_tolerance, kMinToiTolerance), 1.0);
-    if (settings.arithmetic == RobustArithmetic::kExactOnly) {
-        const detail::ExactContact exact = Evaluator::kExact(
-            start, end, t_min, t_max, exact_tolerance, detail::Arithmetic::kExactOnly);
+    // The exact stage over [t0, max_time] (no contact happens before t0).
+    auto decideExactly = [&](double t0, detail::Arithmetic arithmetic) {
+        const detail::ExactContact exact =
+            Evaluator::kExact(start, end, t0, t_max, exact_tolerance, arithmetic);
         result.hit = exact.hit;
         result.toi = exact.hit ? exact.toi : 1.0;
         result.decided_exactly = true;
         return result;
+    };
+    if (settings.arithmetic == RobustArithmetic::kExactOnly) {
+        return decideExactly(t_min, detail::Arithmetic::kExactOnly);
     }
-    double t_from = t_min;  // no contact before t_from
     if (settings.arithmetic == RobustArithmetic::kCertified) {
         const detail::CertifiedOutcome certified = Evaluator::kCertified(
             start, end, t_min, t_max, std::max(settings.toi_tolerance, kMinToiTolerance));
-        if (certified.verdict == detail::CertifiedOutcome::Verdict::kNoContact) {
-            return result;
+        result.boxes = certified.intervals;
+        if (certified.verdict == detail::CertifiedOutcome::Verdict::kUndecided) {
+            // What the certificates leave is degenerate (an exact touch, coplanar motion, a
+            // double root): the inclusion search would only delay the exact stage.
+            return decideExactly(certified.resume_from, detail::Arithmetic::kFiltered);
         }
-        if (certified.verdict == detail::CertifiedOutcome::Verdict::kContact) {
-            result.hit = true;
-            result.toi = certified.toi;
-            return result;
-        }
-        t_from = certified.resume_from;
+        result.hit = certified.verdict == detail::CertifiedOutcome::Verdict::kContact;
+        result.toi = result.hit ? certified.toi : 1.0;
+        return result;
+    }
+    double largest = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        largest = std::max({largest, start[i].cwiseAbs().maxCoeff(), end[i].cwiseAbs().maxCoeff()});
+    }
+    if (largest > kMaxCoordinate) {
+        return decideExactly(t_min, detail::Arithmetic::kFiltered);  // the search's bound
     }
     std::array<std::array<double, 3>, 4> x0{}, dx{};
     std::array<double, 3> eps{};
@@ -386,18 +396,10 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     std::priority_queue<Box, std::vector<Box>, LaterBox> queue;
     // Any double t is evaluated exactly as given, and a rounded midpoint still lies in
     // [t0, t1], so boxes keep covering [min_time, max_time] without dyadic end points.
-    queue.push({t_from, t_max, 0.0, 1.0, 0.0, 1.0, 0});
+    queue.push({t_min, t_max, 0.0, 1.0, 0.0, 1.0, 0});
     Corners f;
     // Boxes are examined in order of t0 and every box before was excluded, so no contact
     // happens before t0: the exact decision only needs [t0, max_time].
-    auto decideExactly = [&](double t0) {
-        const detail::ExactContact exact = Evaluator::kExact(start, end, t0, t_max, exact_tolerance,
-                                                             detail::Arithmetic::kFiltered);
-        result.hit = exact.hit;
-        result.toi = exact.hit ? exact.toi : 1.0;
-        result.decided_exactly = true;
-        return result;
-    };
     double handoff_width = -1.0;  // set from the first (whole-domain) box
     while (!queue.empty()) {
         const Box b = queue.top();
@@ -407,7 +409,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         }
         if (++result.boxes > settings.max_boxes) {
             result.budget_exhausted = true;
-            return decideExactly(b.t0);
+            return decideExactly(b.t0, detail::Arithmetic::kFiltered);
         }
         evaluate(x0, dx, b, f);
         bool excluded = false;
@@ -434,7 +436,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             handoff_width = settings.tolerance * width;
         }
         if (width <= handoff_width) {
-            return decideExactly(b.t0);
+            return decideExactly(b.t0, detail::Arithmetic::kFiltered);
         }
         // Split the dimension along which F varies most (largest change between the
         // corner pairs that differ only in that dimension). Time is favoured (x4): a
@@ -465,7 +467,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         if (variation[d] < 0.0) {
             // Cannot split further without losing exactness: the exact decision takes over.
             result.budget_exhausted = true;
-            return decideExactly(b.t0);
+            return decideExactly(b.t0, detail::Arithmetic::kFiltered);
         }
         Box lo = b, hi = b;
         lo.depth = hi.depth = b.depth + 1;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 
 // The method. Contact needs the four points coplanar: c(t) = det(x1 - x0, x2 - x0, x3 - x0)
 // (vertex-face: x0 = a, the others b, c, p; edge-edge: x0 = a0, then a1, b0, b1) vanishes.
@@ -37,98 +38,194 @@
 namespace kolize::ccd::detail {
 namespace {
 
-constexpr double kU = 0x1p-53;
 /// Absolute slack per operation: covers underflow (at most 2^-1075 per rounding).
 constexpr double kEta = 0x1p-1000;
+
+// ---------------------------------------------------------------------------------------
+// Double-double numbers (hi + lo, |lo| <= ulp(hi) / 2) for the second pass: the same
+// certificates with errors about 2^-100 relative instead of 2^-50, which settles near misses
+// down to ~1e-25 of the scene without exact arithmetic. Exact TwoSum, and Dekker's
+// TwoProduct (no FMA needed; exact while |x| < 2^996, the scaled values are below 4); the
+// sum is Joldes, Muller and Popescu's AccurateDWPlusDW (relative error below 3u^2 + 13u^3,
+// u = 2^-53), the products DWTimesDW1 and its DW-times-double form (below 7u^2; ACM TOMS
+// 44(2), 2017). Every operation is charged 16u^2 = 2^-102 (CRlibm's bound for Mul22).
+// ---------------------------------------------------------------------------------------
+
+struct DD {
+    double hi = 0.0, lo = 0.0;
+};
+
+DD twoSum(double a, double b) {
+    const double s = a + b, bb = s - a;
+    return {s, (a - (s - bb)) + (b - bb)};
+}
+
+DD fastTwoSum(double a, double b) {  // |a| >= |b|
+    const double s = a + b;
+    return {s, b - (s - a)};
+}
+
+DD twoProduct(double a, double b) {
+    constexpr double kSplit = 134217729.0;  // 2^27 + 1
+    const double p = a * b;
+    const double ca = kSplit * a, cb = kSplit * b;
+    const double ah = ca - (ca - a), al = a - ah, bh = cb - (cb - b), bl = b - bh;
+    return {p, ((ah * bh - p) + ah * bl + al * bh) + al * bl};
+}
+
+DD operator+(const DD& a, const DD& b) {
+    const DD s = twoSum(a.hi, b.hi), t = twoSum(a.lo, b.lo);
+    DD r = fastTwoSum(s.hi, s.lo + t.hi);
+    return fastTwoSum(r.hi, r.lo + t.lo);
+}
+
+DD operator-(const DD& a) {
+    return {-a.hi, -a.lo};
+}
+
+DD operator-(const DD& a, const DD& b) {
+    return a + (-b);
+}
+
+DD operator*(const DD& a, const DD& b) {
+    const DD c = twoProduct(a.hi, b.hi);
+    return fastTwoSum(c.hi, c.lo + (a.hi * b.lo + a.lo * b.hi));
+}
+
+DD operator*(double t, const DD& b) {
+    const DD c = twoProduct(t, b.hi);
+    return fastTwoSum(c.hi, c.lo + t * b.lo);
+}
+
+double toDouble(double x) {
+    return x;
+}
+
+double toDouble(const DD& x) {
+    return x.hi;
+}
+
+double scaled(double x, int e) {
+    return std::ldexp(x, e);
+}
+
+DD scaled(const DD& x, int e) {
+    return {std::ldexp(x.hi, e), std::ldexp(x.lo, e)};
+}
+
+/// The relative rounding error of one operation, per number type.
+template <class R>
+constexpr double kUnit = 0x1p-53;
+template <>
+constexpr double kUnit<DD> = 0x1p-102;
+
+/// x - y, exact as a double-double, once rounded as a double.
+double difference(double x, double y, double) {
+    return x - y;
+}
+
+DD difference(double x, double y, DD) {
+    return twoSum(x, -y);
+}
+
+/// Certainly positive (1), negative (-1), or neither (0) given |x - exact| <= error. A
+/// double-double's hi part is within 2^-53 relative of its value, so it decides.
+int certainSign(double x, double error) {
+    return x > error ? 1 : (x < -error ? -1 : 0);
+}
+
+int certainSign(const DD& x, double error) {
+    const double e = error * (1.0 + 0x1p-50);
+    return x.hi > e ? 1 : (x.hi < -e ? -1 : 0);
+}
+
+// ---------------------------------------------------------------------------------------
+// Error bounds, at compile time.
+// ---------------------------------------------------------------------------------------
 
 /// A computed value's bounds: |exact| <= m and |computed - exact| <= e.
 struct Bound {
     double m, e;
 };
 
-constexpr Bound mul(Bound a, Bound b) {
-    return {a.m * b.m, a.m * b.e + b.m * a.e + a.e * b.e + kU * (a.m + a.e) * (b.m + b.e) + kEta};
-}
+/// The errors of every certified quantity for operations of relative error u, after the
+/// scaling; `exact_inputs`: the difference vectors at t = 0 and 1 carry no rounding.
+struct Errors {
+    double det, det_sum, cross, cross_sum, diff_cross, diff_cross_sum;
 
-constexpr Bound add(Bound a, Bound b) {
-    return {a.m + b.m, a.e + b.e + kU * (a.m + a.e + b.m + b.e) + kEta};
-}
+    static constexpr Errors compute(double u, bool exact_inputs) {
+        auto mul = [u](Bound a, Bound b) {
+            return Bound{a.m * b.m,
+                         a.m * b.e + b.m * a.e + a.e * b.e + u * (a.m + a.e) * (b.m + b.e) + kEta};
+        };
+        auto add = [u](Bound a, Bound b) {
+            return Bound{a.m + b.m, a.e + b.e + u * (a.m + a.e + b.m + b.e) + kEta};
+        };
+        auto cross2 = [&](Bound a, Bound b) { return add(mul(a, b), mul(a, b)); };
+        // A scaled difference component: |value| < 2 by the scaling.
+        const Bound input{2.0 * (1.0 + 0x1p-51),
+                          (exact_inputs ? 0.0 : 2.0 * u * (1.0 + 4.0 * u)) + kEta};
+        const Bound rate = add(input, input);             // x1 - x0
+        const Bound scaled = mul(Bound{1.0, 0.0}, rate);  // t (x1 - x0), t in [0, 1]
+        // x0 + t (x1 - x0): the exact value is a convex combination, below input.m.
+        const Bound at{input.m, input.e + scaled.e + u * (input.m + input.e + scaled.e) + kEta};
+        const Bound diff = add(at, at);  // a difference of two vectors at one time
+        const Bound c = cross2(at, at);
+        const Bound det = add(add(mul(at, c), mul(at, c)), mul(at, c));  // x . (y x z)
+        const Bound cross_diff = cross2(diff, diff);
+        // The bound is itself computed in rounded arithmetic (a few dozen roundings).
+        constexpr double kWiden = 1.0 + 0x1p-20;
+        return {det.e * kWiden,        add(add(det, det), det).e * kWiden,
+                c.e * kWiden,          add(c, c).e * kWiden,
+                cross_diff.e * kWiden, add(cross_diff, cross_diff).e * kWiden};
+    }
+};
 
-/// The bound itself is computed in rounded arithmetic (a few dozen roundings): widen it.
-constexpr double finalError(Bound a) {
-    return a.e * (1.0 + 0x1p-20);
-}
+template <class R>
+constexpr Errors kErrors = Errors::compute(kUnit<R>, false);
+template <>
+constexpr Errors kErrors<DD> = Errors::compute(kUnit<DD>, true);
+static_assert(kErrors<double>.det < 1e-12 && kErrors<double>.diff_cross_sum < 1e-12,
+              "bounds as analysed");
+static_assert(kErrors<DD>.det < 1e-26, "bounds as analysed");
 
-/// A scaled difference component (|value| < 2 by the scaling, one rounding).
-constexpr Bound kInput{2.0 * (1.0 + 4.0 * kU), 2.0 * kU*(1.0 + 4.0 * kU) + kEta};
-/// x1 - x0 of a component at the two ends.
-constexpr Bound kRate = add(kInput, kInput);
-/// t (x1 - x0) for a double t in [0, 1].
-constexpr Bound kScaledRate = mul(Bound{1.0, 0.0}, kRate);
-/// x0 + t (x1 - x0): the exact value is a convex combination, so still below kInput.m.
-constexpr Bound kAt{kInput.m,
-                    kInput.e + kScaledRate.e + kU*(kInput.m + kInput.e + kScaledRate.e) + kEta};
-/// The difference of two such vectors at one time.
-constexpr Bound kDiff = add(kAt, kAt);
-
-constexpr Bound cross2(Bound a, Bound b) {
-    return add(mul(a, b), mul(a, b));
-}
-
-/// x . (y x z), the cross product first.
-constexpr Bound det3(Bound x, Bound y, Bound z) {
-    const Bound c = cross2(y, z);
-    return add(add(mul(x, c), mul(x, c)), mul(x, c));
-}
-
-constexpr Bound kDet = det3(kAt, kAt, kAt);
-constexpr Bound kDetSum = add(add(kDet, kDet), kDet);
-constexpr Bound kCross = cross2(kAt, kAt);
-constexpr Bound kCrossSum = add(kCross, kCross);
-constexpr Bound kDiffCross = cross2(kDiff, kDiff);
-constexpr Bound kDiffCrossSum = add(kDiffCross, kDiffCross);
-
-constexpr double kDetError = finalError(kDet);
-constexpr double kDetSumError = finalError(kDetSum);
-constexpr double kCrossError = finalError(kCross);
-constexpr double kCrossSumError = finalError(kCrossSum);
-constexpr double kDiffCrossError = finalError(kDiffCross);
-constexpr double kDiffCrossSumError = finalError(kDiffCrossSum);
-static_assert(kDetError < 1e-12 && kDiffCrossSumError < 1e-12, "bounds as analysed");
-
-/// Intervals examined before the exact stage takes over, and how often one may be halved.
-constexpr int kMaxIntervals = 24;
+/// Intervals examined before the next pass (or the exact stage) takes over, and how often
+/// one may be halved.
+constexpr int kMaxIntervals = 10;
+constexpr int kMaxDoubleDouble = 10;
 constexpr int kMaxDepth = 10;
 
-using V3 = std::array<double, 3>;
+template <class R>
+using V3 = std::array<R, 3>;
 /// The three difference vectors at one time.
-using Frame = std::array<V3, 3>;
+template <class R>
+using Frame = std::array<V3<R>, 3>;
 
-V3 sub(const V3& a, const V3& b) {
+template <class R>
+V3<R> sub(const V3<R>& a, const V3<R>& b) {
     return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
 
-double det(const V3& x, const V3& y, const V3& z) {
-    const double c0 = y[1] * z[2] - y[2] * z[1];
-    const double c1 = y[2] * z[0] - y[0] * z[2];
-    const double c2 = y[0] * z[1] - y[1] * z[0];
+template <class R>
+R det(const V3<R>& x, const V3<R>& y, const V3<R>& z) {
+    const R c0 = y[1] * z[2] - y[2] * z[1];
+    const R c1 = y[2] * z[0] - y[0] * z[2];
+    const R c2 = y[0] * z[1] - y[1] * z[0];
     return (x[0] * c0 + x[1] * c1) + x[2] * c2;
 }
 
 /// The k-th component of u x w: the orientation in the projection that drops axis k.
-double cross(const V3& u, const V3& w, int k) {
-    const int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
+template <class R>
+R cross(const V3<R>& u, const V3<R>& w, int k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
     return u[i] * w[j] - u[j] * w[i];
-}
-
-int certainSign(double x, double error) {
-    return x > error ? 1 : (x < -error ? -1 : 0);
 }
 
 /// Sign of the quadratic u(t) x w(t) (component k) over the interval whose ends hold (ua,
 /// wa) and (ub, wb), if its Bernstein coefficients certify one; else 0.
-int quadraticSign(const V3& ua, const V3& wa, const V3& ub, const V3& wb, int k, double error,
-                  double sum_error) {
+template <class R>
+int quadraticSign(const V3<R>& ua, const V3<R>& wa, const V3<R>& ub, const V3<R>& wb, int k,
+                  double error, double sum_error) {
     const int s0 = certainSign(cross(ua, wa, k), error);
     if (s0 == 0) {
         return 0;
@@ -142,17 +239,18 @@ int quadraticSign(const V3& ua, const V3& wa, const V3& ub, const V3& wb, int k,
 }
 
 /// The query as three difference vectors from vertex `base`, scaled per axis.
+template <class R>
 class Motion {
   public:
     /// False when a difference overflows (then only the exact stage can decide).
     bool prepare(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                  const std::array<int, 4>& order) {
-        std::array<std::array<V3, 3>, 2> d;
+        std::array<std::array<V3<R>, 3>, 2> d;
         for (int side = 0; side < 2; ++side) {
             const std::array<Vec3, 4>& x = side ? end : start;
             for (int v = 0; v < 3; ++v) {
                 for (int k = 0; k < 3; ++k) {
-                    d[side][v][k] = x[order[v + 1]][k] - x[order[0]][k];
+                    d[side][v][k] = difference(x[order[v + 1]][k], x[order[0]][k], R());
                 }
             }
         }
@@ -160,7 +258,7 @@ class Motion {
             double largest = 0.0;
             for (int side = 0; side < 2; ++side) {
                 for (int v = 0; v < 3; ++v) {
-                    largest = std::max(largest, std::abs(d[side][v][k]));
+                    largest = std::max(largest, std::abs(toDouble(d[side][v][k])));
                 }
             }
             if (!std::isfinite(largest)) {
@@ -169,7 +267,7 @@ class Motion {
             // 2^-e with largest * 2^-e in [1, 2); an axis without extent stays as it is.
             const int e = largest > 0.0 ? std::ilogb(largest) : 0;
             for (int v = 0; v < 3; ++v) {
-                const double s0 = std::ldexp(d[0][v][k], -e), s1 = std::ldexp(d[1][v][k], -e);
+                const R s0 = scaled(d[0][v][k], -e), s1 = scaled(d[1][v][k], -e);
                 start_[v][k] = s0;
                 rate_[v][k] = s1 - s0;
             }
@@ -177,8 +275,8 @@ class Motion {
         return true;
     }
 
-    Frame at(double t) const {
-        Frame f;
+    Frame<R> at(double t) const {
+        Frame<R> f;
         for (int v = 0; v < 3; ++v) {
             for (int k = 0; k < 3; ++k) {
                 f[v][k] = start_[v][k] + t * rate_[v][k];
@@ -188,15 +286,17 @@ class Motion {
     }
 
   private:
-    Frame start_{}, rate_{};
+    Frame<R> start_{}, rate_{};
 };
 
 /// c(t) = det of the frame at one time, with its certain sign (0: uncertain).
-int coplanaritySign(const Frame& f) {
-    return certainSign(det(f[0], f[1], f[2]), kDetError);
+template <class R>
+int coplanaritySign(const Frame<R>& f) {
+    return certainSign(det(f[0], f[1], f[2]), kErrors<R>.det);
 }
 
-/// The cubic's Bernstein coefficients on the interval (times 1, 3, 3, 1) and their signs.
+/// The cubic's Bernstein coefficients on the interval (times 1, 3, 3, 1): their signs, and
+/// approximate values for a root guess.
 struct Cubic {
     std::array<double, 4> b;
     std::array<int, 4> sign;
@@ -214,17 +314,33 @@ struct Cubic {
         }
         return variations == 1;
     }
-    bool vanishes() const { return sign[0] == 0 && sign[1] == 0 && sign[2] == 0 && sign[3] == 0; }
 };
 
-Cubic coplanarity(const Frame& a, const Frame& b) {
+/// y x z, the cross product of det(x, y, z) = x . (y x z).
+template <class R>
+V3<R> cross3(const V3<R>& y, const V3<R>& z) {
+    return {y[1] * z[2] - y[2] * z[1], y[2] * z[0] - y[0] * z[2], y[0] * z[1] - y[1] * z[0]};
+}
+
+template <class R>
+R dot(const V3<R>& x, const V3<R>& c) {
+    return (x[0] * c[0] + x[1] * c[1]) + x[2] * c[2];
+}
+
+template <class R>
+Cubic coplanarity(const Frame<R>& a, const Frame<R>& b) {
+    // The eight determinants share four cross products (same operations as det()).
+    const V3<R> aa = cross3(a[1], a[2]), ba = cross3(b[1], a[2]), ab = cross3(a[1], b[2]),
+                bb = cross3(b[1], b[2]);
+    std::array<R, 4> v;
+    v[0] = dot(a[0], aa);
+    v[1] = (dot(b[0], aa) + dot(a[0], ba)) + dot(a[0], ab);
+    v[2] = (dot(a[0], bb) + dot(b[0], ab)) + dot(b[0], ba);
+    v[3] = dot(b[0], bb);
     Cubic c;
-    c.b[0] = det(a[0], a[1], a[2]);
-    c.b[1] = (det(b[0], a[1], a[2]) + det(a[0], b[1], a[2])) + det(a[0], a[1], b[2]);
-    c.b[2] = (det(a[0], b[1], b[2]) + det(b[0], a[1], b[2])) + det(b[0], b[1], a[2]);
-    c.b[3] = det(b[0], b[1], b[2]);
     for (int i = 0; i < 4; ++i) {
-        c.sign[i] = certainSign(c.b[i], i == 0 || i == 3 ? kDetError : kDetSumError);
+        c.b[i] = toDouble(v[i]);
+        c.sign[i] = certainSign(v[i], i == 0 || i == 3 ? kErrors<R>.det : kErrors<R>.det_sum);
     }
     return c;
 }
@@ -263,25 +379,32 @@ double approximateRoot(const std::array<double, 4>& bern) {
 struct VertexFaceKind {
     // x0 = a (vertex 1); vectors e1 = b - a, e2 = c - a, q = p - a.
     static constexpr std::array<int, 4> kOrder{1, 2, 3, 0};
-    /// The normal's direction (any scale), to choose projections by.
-    static V3 normal(const Frame& f) {
-        return {cross(f[0], f[1], 0), cross(f[0], f[1], 1), cross(f[0], f[1], 2)};
+    /// The normal's direction (approximately, any scale), to choose projections by.
+    template <class R>
+    static V3<double> normal(const Frame<R>& f) {
+        V3<double> n;
+        for (int k = 0; k < 3; ++k) {
+            n[k] = toDouble(cross(f[0], f[1], k));
+        }
+        return n;
     }
     /// +1: strictly inside over the interval in projection k; -1: outside at every
     /// coplanar time of it; 0: neither certified.
-    static int classify(const Frame& a, const Frame& b, int k) {
-        const V3 &e1a = a[0], &e2a = a[1], &qa = a[2], &e1b = b[0], &e2b = b[1], &qb = b[2];
-        const int n = quadraticSign(e1a, e2a, e1b, e2b, k, kCrossError, kCrossSumError);
-        const int ab = quadraticSign(e1a, qa, e1b, qb, k, kCrossError, kCrossSumError);
+    template <class R>
+    static int classify(const Frame<R>& a, const Frame<R>& b, int k) {
+        const Errors& e = kErrors<R>;
+        const V3<R>&e1a = a[0], &e2a = a[1], &qa = a[2], &e1b = b[0], &e2b = b[1], &qb = b[2];
+        const int n = quadraticSign(e1a, e2a, e1b, e2b, k, e.cross, e.cross_sum);
+        const int ab = quadraticSign(e1a, qa, e1b, qb, k, e.cross, e.cross_sum);
         if (n != 0 && ab == -n) {
             return -1;
         }
-        const int ca = quadraticSign(qa, e2a, qb, e2b, k, kCrossError, kCrossSumError);
+        const int ca = quadraticSign(qa, e2a, qb, e2b, k, e.cross, e.cross_sum);
         if (n != 0 && ca == -n) {
             return -1;
         }
         const int bc = quadraticSign(sub(e2a, e1a), sub(qa, e1a), sub(e2b, e1b), sub(qb, e1b), k,
-                                     kDiffCrossError, kDiffCrossSumError);
+                                     e.diff_cross, e.diff_cross_sum);
         if (n != 0 && bc == -n) {
             return -1;
         }
@@ -293,22 +416,29 @@ struct VertexFaceKind {
 struct EdgeEdgeKind {
     // x0 = a0 (vertex 0); vectors ea = a1 - a0, r0 = b0 - a0, r1 = b1 - a0.
     static constexpr std::array<int, 4> kOrder{0, 1, 2, 3};
-    static V3 normal(const Frame& f) {
-        const V3 eb = sub(f[2], f[1]);
-        return {cross(f[0], eb, 0), cross(f[0], eb, 1), cross(f[0], eb, 2)};
+    template <class R>
+    static V3<double> normal(const Frame<R>& f) {
+        const V3<R> eb = sub(f[2], f[1]);
+        V3<double> n;
+        for (int k = 0; k < 3; ++k) {
+            n[k] = toDouble(cross(f[0], eb, k));
+        }
+        return n;
     }
-    static int classify(const Frame& a, const Frame& b, int k) {
-        const V3 &eaa = a[0], &r0a = a[1], &r1a = a[2], &eab = b[0], &r0b = b[1], &r1b = b[2];
+    template <class R>
+    static int classify(const Frame<R>& a, const Frame<R>& b, int k) {
+        const Errors& e = kErrors<R>;
+        const V3<R>&eaa = a[0], &r0a = a[1], &r1a = a[2], &eab = b[0], &r0b = b[1], &r1b = b[2];
         // b0, b1 against the line of A.
-        const int s0 = quadraticSign(eaa, r0a, eab, r0b, k, kCrossError, kCrossSumError);
-        const int s1 = quadraticSign(eaa, r1a, eab, r1b, k, kCrossError, kCrossSumError);
+        const int s0 = quadraticSign(eaa, r0a, eab, r0b, k, e.cross, e.cross_sum);
+        const int s1 = quadraticSign(eaa, r1a, eab, r1b, k, e.cross, e.cross_sum);
         if (s0 != 0 && s0 == s1) {
             return -1;  // B strictly on one side of A's line in a projection: no contact
         }
         // a0, a1 against the line of B: (b1 - b0) x (a - b0) for a = a0 (= r0 x r1), a1.
-        const int s2 = quadraticSign(r0a, r1a, r0b, r1b, k, kCrossError, kCrossSumError);
+        const int s2 = quadraticSign(r0a, r1a, r0b, r1b, k, e.cross, e.cross_sum);
         const int s3 = quadraticSign(sub(r1a, r0a), sub(eaa, r0a), sub(r1b, r0b), sub(eab, r0b), k,
-                                     kDiffCrossError, kDiffCrossSumError);
+                                     e.diff_cross, e.diff_cross_sum);
         if (s2 != 0 && s2 == s3) {
             return -1;
         }
@@ -317,7 +447,7 @@ struct EdgeEdgeKind {
 };
 
 /// Projections in order of the normal's magnitude along the dropped axis.
-std::array<int, 3> projections(V3 n) {
+std::array<int, 3> projections(V3<double> n) {
     std::array<int, 3> k{0, 1, 2};
     for (double& x : n) {
         x = std::abs(x);
@@ -326,10 +456,10 @@ std::array<int, 3> projections(V3 n) {
     return k;
 }
 
-template <class Kind>
-int classifyAnyProjection(const Frame& a, const Frame& b, bool want_inside) {
-    V3 n = Kind::normal(a);
-    const V3 nb = Kind::normal(b);
+template <class Kind, class R>
+int classifyAnyProjection(const Frame<R>& a, const Frame<R>& b, bool want_inside) {
+    V3<double> n = Kind::normal(a);
+    const V3<double> nb = Kind::normal(b);
     for (int k = 0; k < 3; ++k) {
         n[k] += nb[k];
     }
@@ -342,32 +472,45 @@ int classifyAnyProjection(const Frame& a, const Frame& b, bool want_inside) {
     return 0;
 }
 
+template <class R>
 struct Interval {
     double lo, hi;
-    Frame a, b;  // the frames at lo and hi
+    Frame<R> a, b;  // the frames at lo and hi
     int depth;
 };
 
-template <class Kind>
+template <class Kind, class R>
 class Certifier {
   public:
-    Certifier(const Motion& motion, double tolerance) : motion_(motion), tolerance_(tolerance) {}
+    Certifier(const Motion<R>& motion, double t_lo, double t_hi, double tolerance)
+        : motion_(motion), t_lo_(t_lo), t_hi_(t_hi), tolerance_(tolerance) {}
 
-    enum class Result { kExcluded, kContact, kUndecided, kGiveUp };
+    enum class Result { kExcluded, kContact, kUndecided, kGiveUp, kTrimmed };
 
     /// Decides one interval; kContact sets toi_.
-    Result examine(const Interval& in) {
+    Result examine(const Interval<R>& in) {
         const Cubic c = coplanarity(in.a, in.b);
         if (c.oneSign()) {
             return Result::kExcluded;
         }
         if (!c.oneRoot()) {
             const int o = classifyAnyProjection<Kind>(in.a, in.b, false);
-            return o == -1 ? Result::kExcluded : Result::kUndecided;
+            if (o == -1) {
+                return Result::kExcluded;
+            }
+            // c vanishing at an end of the whole range, to this precision: most likely an
+            // exact root there (a contact exactly at the start or the end of the step, or
+            // coplanar motion), which no amount of halving settles. A thin slice at that end
+            // may still be outside; otherwise hand it on at once.
+            const bool at_lo = in.lo == t_lo_ && c.sign[0] == 0;
+            if (at_lo || (in.hi == t_hi_ && c.sign[3] == 0)) {
+                return trimEnd(in, at_lo);
+            }
+            return Result::kUndecided;
         }
         // One simple root t*: bracket it within the tolerance, then decide at t*.
         double lo = in.lo, hi = in.hi;
-        Frame flo = in.a, fhi = in.b;
+        Frame<R> flo = in.a, fhi = in.b;
         if (!bracket(c, lo, hi, flo, fhi)) {
             reason_ = "bracket";
             return Result::kGiveUp;
@@ -378,18 +521,44 @@ class Certifier {
             return Result::kContact;
         }
         // Outside: t* is the only coplanar time of the interval. Neither: the static test
-        // at t* is too close to call in doubles (a touch on a boundary, a near miss).
+        // at t* is too close to call at this precision (a touch on a boundary, a near miss).
         reason_ = "at root";
         return o == -1 ? Result::kExcluded : Result::kGiveUp;
     }
 
     double toi() const { return toi_; }
     const char* reason() const { return reason_; }
+    /// After kTrimmed: the interval to examine instead.
+    const Interval<R>& trimmed() const { return trimmed_; }
 
   private:
+    /// Excludes a thin slice at the range's start (at_lo) or end by an "outside"
+    /// certificate and shrinks the range past it (kTrimmed), or gives up.
+    Result trimEnd(const Interval<R>& in, bool at_lo) {
+        const double width = (in.hi - in.lo) * 0x1p-20;
+        const double cut = at_lo ? in.lo + width : in.hi - width;
+        if (in.lo < cut && cut < in.hi) {
+            const Frame<R> fc = motion_.at(cut);
+            const bool outside = at_lo ? classifyAnyProjection<Kind>(in.a, fc, false) == -1
+                                       : classifyAnyProjection<Kind>(fc, in.b, false) == -1;
+            if (outside) {
+                if (at_lo) {
+                    trimmed_ = {cut, in.hi, fc, in.b, in.depth};
+                    t_lo_ = cut;
+                } else {
+                    trimmed_ = {in.lo, cut, in.a, fc, in.depth};
+                    t_hi_ = cut;
+                }
+                return Result::kTrimmed;
+            }
+        }
+        reason_ = "end";
+        return Result::kGiveUp;
+    }
+
     /// Narrows [lo, hi] (c certainly changing sign once on it) to at most half the
     /// tolerance around the root, with certain signs of c at the new ends.
-    bool bracket(const Cubic& c, double& lo, double& hi, Frame& flo, Frame& fhi) const {
+    bool bracket(const Cubic& c, double& lo, double& hi, Frame<R>& flo, Frame<R>& fhi) const {
         const double width = 0.5 * tolerance_;
         if (hi - lo <= width) {
             return true;
@@ -399,7 +568,8 @@ class Certifier {
         const double delta = 0.25 * width;
         const double l = std::max(lo, guess - delta), h = std::min(hi, guess + delta);
         if (h - l <= width && l < h) {
-            const Frame fl = l == lo ? flo : motion_.at(l), fh = h == hi ? fhi : motion_.at(h);
+            const Frame<R> fl = l == lo ? flo : motion_.at(l);
+            const Frame<R> fh = h == hi ? fhi : motion_.at(h);
             if ((l == lo || coplanaritySign(fl) == sign_lo) &&
                 (h == hi || coplanaritySign(fh) == -sign_lo)) {
                 lo = l;
@@ -417,7 +587,7 @@ class Certifier {
                 if (!(lo < m && m < hi)) {
                     break;
                 }
-                const Frame fm = motion_.at(m);
+                const Frame<R> fm = motion_.at(m);
                 const int s = coplanaritySign(fm);
                 if (s != 0) {
                     (s == sign_lo ? lo : hi) = m;
@@ -433,46 +603,52 @@ class Certifier {
         return true;
     }
 
-    const Motion& motion_;
-    double tolerance_;
+    const Motion<R>& motion_;
+    double t_lo_, t_hi_, tolerance_;
     double toi_ = 1.0;
+    Interval<R> trimmed_{};
     const char* reason_ = "";
 };
 
-template <class Kind>
-CertifiedOutcome certify(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
-                         double t_lo, double t_hi, double tolerance) {
+/// One pass of the certified search at the precision of R, over [t_lo, t_hi].
+template <class Kind, class R>
+CertifiedOutcome certifyPass(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
+                             double t_lo, double t_hi, double tolerance, int max_intervals) {
     CertifiedOutcome out;
     out.resume_from = t_lo;
-    Motion motion;
+    Motion<R> motion;
     if (!motion.prepare(start, end, Kind::kOrder)) {
         out.reason = "overflow";
         return out;
     }
-    Certifier<Kind> certifier(motion, tolerance);
+    Certifier<Kind, R> certifier(motion, t_lo, t_hi, tolerance);
+    using Result = typename Certifier<Kind, R>::Result;
     // Depth first from the left: when an interval is examined, everything before it is
     // excluded.
-    std::array<Interval, kMaxDepth + 2> stack;
+    std::array<Interval<R>, kMaxDepth + 2> stack;
     int size = 0;
     stack[size++] = {t_lo, t_hi, motion.at(t_lo), motion.at(t_hi), 0};
     while (size > 0) {
-        const Interval in = stack[--size];
+        const Interval<R> in = stack[--size];
         out.resume_from = in.lo;
-        if (++out.intervals > kMaxIntervals) {
+        if (++out.intervals > max_intervals) {
             out.reason = "budget";
             return out;
         }
         switch (certifier.examine(in)) {
-            case Certifier<Kind>::Result::kExcluded:
+            case Result::kExcluded:
                 continue;
-            case Certifier<Kind>::Result::kContact:
+            case Result::kContact:
                 out.verdict = CertifiedOutcome::Verdict::kContact;
                 out.toi = certifier.toi();
                 return out;
-            case Certifier<Kind>::Result::kGiveUp:
+            case Result::kGiveUp:
                 out.reason = certifier.reason();
                 return out;
-            case Certifier<Kind>::Result::kUndecided:
+            case Result::kTrimmed:
+                stack[size++] = certifier.trimmed();
+                continue;
+            case Result::kUndecided:
                 break;
         }
         const double mid = in.lo + 0.5 * (in.hi - in.lo);
@@ -480,11 +656,27 @@ CertifiedOutcome certify(const std::array<Vec3, 4>& start, const std::array<Vec3
             out.reason = "depth";
             return out;
         }
-        const Frame fm = motion.at(mid);
+        const Frame<R> fm = motion.at(mid);
         stack[size++] = {mid, in.hi, fm, in.b, in.depth + 1};
         stack[size++] = {in.lo, mid, in.a, fm, in.depth + 1};
     }
     out.verdict = CertifiedOutcome::Verdict::kNoContact;
+    return out;
+}
+
+/// Doubles first; where they cannot decide, double-doubles from there on.
+template <class Kind>
+CertifiedOutcome certify(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
+                         double t_lo, double t_hi, double tolerance) {
+    CertifiedOutcome out =
+        certifyPass<Kind, double>(start, end, t_lo, t_hi, tolerance, kMaxIntervals);
+    if (out.verdict != CertifiedOutcome::Verdict::kUndecided ||
+        std::string_view(out.reason) == "overflow") {
+        return out;
+    }
+    const int intervals = out.intervals;
+    out = certifyPass<Kind, DD>(start, end, out.resume_from, t_hi, tolerance, kMaxDoubleDouble);
+    out.intervals += intervals;
     return out;
 }
 

@@ -313,6 +313,13 @@ RobustSettings withArithmetic(RobustArithmetic arithmetic) {
     return s;
 }
 
+/// The certified stage brackets contacts more coarsely or as finely as a double allows.
+RobustSettings withToiTolerance(double tolerance) {
+    RobustSettings s;
+    s.toi_tolerance = tolerance;
+    return s;
+}
+
 /// The inclusion search hands its first box to the exact stage.
 RobustSettings withExactHandOff(RobustArithmetic arithmetic) {
     RobustSettings s = withArithmetic(arithmetic);
@@ -417,7 +424,8 @@ Query generate(uint64_t seed, uint64_t index, int family) {
 const std::vector<Mode>& modes() {
     static const std::vector<Mode> kModes{
         {"certified", RobustSettings{}},
-        {"certified-exact-hand-off", withExactHandOff(RobustArithmetic::kCertified)},
+        {"certified-coarse-toi", withToiTolerance(0.25)},
+        {"certified-finest-toi", withToiTolerance(0x1p-52)},
         {"search-then-exact", withArithmetic(RobustArithmetic::kSearchThenExact)},
         {"search-exact-hand-off", withExactHandOff(RobustArithmetic::kSearchThenExact)},
         {"search-fine", withFineSearch()},
