@@ -322,6 +322,14 @@ void validate(const char* function, const std::array<Vec3, 4>& start,
     if (std::isnan(settings.min_time) || std::isnan(settings.max_time)) {
         fail("RobustSettings::min_time and max_time must not be NaN");
     }
+    // x - x is 0 for a finite x and NaN otherwise: one test for all 24 in the common case.
+    double probe = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        probe += (start[i] - start[i]).sum() + (end[i] - end[i]).sum();
+    }
+    if (probe == 0.0) {
+        return;
+    }
     for (int side = 0; side < 2; ++side) {
         for (int i = 0; i < 4; ++i) {
             const Vec3& p = side ? end[i] : start[i];

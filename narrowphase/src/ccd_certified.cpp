@@ -105,12 +105,14 @@ double toDouble(const DD& x) {
     return x.hi;
 }
 
-double scaled(double x, int e) {
-    return std::ldexp(x, e);
+/// x 2^e, as `factor` = 2^e when that is a normal double (a product by a power of two is
+/// exact but for subnormal results, like ldexp, and much cheaper).
+double scaled(double x, int e, double factor) {
+    return factor != 0.0 ? x * factor : std::ldexp(x, e);
 }
 
-DD scaled(const DD& x, int e) {
-    return {std::ldexp(x.hi, e), std::ldexp(x.lo, e)};
+DD scaled(const DD& x, int e, double factor) {
+    return {scaled(x.hi, e, factor), scaled(x.lo, e, factor)};
 }
 
 /// The relative rounding error of one operation, per number type.
@@ -266,8 +268,9 @@ class Motion {
             }
             // 2^-e with largest * 2^-e in [1, 2); an axis without extent stays as it is.
             const int e = largest > 0.0 ? std::ilogb(largest) : 0;
+            const double factor = e > -1000 && e < 1000 ? std::ldexp(1.0, -e) : 0.0;
             for (int v = 0; v < 3; ++v) {
-                const R s0 = scaled(d[0][v][k], -e), s1 = scaled(d[1][v][k], -e);
+                const R s0 = scaled(d[0][v][k], -e, factor), s1 = scaled(d[1][v][k], -e, factor);
                 start_[v][k] = s0;
                 rate_[v][k] = s1 - s0;
             }
@@ -286,7 +289,7 @@ class Motion {
     }
 
   private:
-    Frame<R> start_{}, rate_{};
+    Frame<R> start_, rate_;  // set by prepare()
 };
 
 /// c(t) = det of the frame at one time, with its certain sign (0: uncertain).
@@ -346,8 +349,8 @@ Cubic coplanarity(const Frame<R>& a, const Frame<R>& b) {
 }
 
 /// The simple root of the Bernstein cubic (b with b[0], b[3] of opposite signs) in s in
-/// [0, 1], approximately: safeguarded Newton. Only a guess; it is certified afterwards.
-double approximateRoot(const std::array<double, 4>& bern) {
+/// [0, 1], to about `accuracy`: safeguarded Newton. Only a guess; it is certified after.
+double approximateRoot(const std::array<double, 4>& bern, double accuracy) {
     // Monomial coefficients in s (the middle Bernstein values carry their factor 3).
     const double b0 = bern[0], b1 = bern[1] / 3.0, b2 = bern[2] / 3.0, b3 = bern[3];
     const double m1 = 3.0 * (b1 - b0), m2 = 3.0 * (b2 - 2.0 * b1 + b0);
@@ -367,7 +370,7 @@ double approximateRoot(const std::array<double, 4>& bern) {
         if (!(next > lo && next < hi)) {
             next = 0.5 * (lo + hi);
         }
-        if (next == s || hi - lo < 0x1p-60) {
+        if (std::abs(next - s) < accuracy || hi - lo < accuracy) {
             return next;
         }
         s = next;
@@ -452,7 +455,14 @@ std::array<int, 3> projections(V3<double> n) {
     for (double& x : n) {
         x = std::abs(x);
     }
-    std::sort(k.begin(), k.end(), [&](int i, int j) { return n[i] > n[j]; });
+    auto order = [&](int i, int j) {
+        if (n[k[j]] > n[k[i]]) {
+            std::swap(k[i], k[j]);
+        }
+    };
+    order(0, 1);
+    order(1, 2);
+    order(0, 1);
     return k;
 }
 
@@ -564,8 +574,8 @@ class Certifier {
             return true;
         }
         const int sign_lo = c.sign[0];
-        const double guess = lo + approximateRoot(c.b) * (hi - lo);
         const double delta = 0.25 * width;
+        const double guess = lo + approximateRoot(c.b, 0x1p-4 * delta / (hi - lo)) * (hi - lo);
         const double l = std::max(lo, guess - delta), h = std::min(hi, guess + delta);
         if (h - l <= width && l < h) {
             const Frame<R> fl = l == lo ? flo : motion_.at(l);
@@ -606,7 +616,7 @@ class Certifier {
     const Motion<R>& motion_;
     double t_lo_, t_hi_, tolerance_;
     double toi_ = 1.0;
-    Interval<R> trimmed_{};
+    Interval<R> trimmed_;
     const char* reason_ = "";
 };
 
