@@ -317,6 +317,7 @@ struct Cubic {
         }
         return variations == 1;
     }
+    bool vanishes() const { return sign[0] == 0 && sign[1] == 0 && sign[2] == 0 && sign[3] == 0; }
 };
 
 /// y x z, the cross product of det(x, y, z) = x . (y x z).
@@ -512,9 +513,15 @@ class Certifier {
             // exact root there (a contact exactly at the start or the end of the step, or
             // coplanar motion), which no amount of halving settles. A thin slice at that end
             // may still be outside; otherwise hand it on at once.
+            // c vanishing on the whole interval (coplanar motion, to this precision): no
+            // contact can be certified here, and halving will not change that.
+            if (c.vanishes()) {
+                reason_ = "coplanar";
+                return Result::kGiveUp;
+            }
             const bool at_lo = in.lo == t_lo_ && c.sign[0] == 0;
             if (at_lo || (in.hi == t_hi_ && c.sign[3] == 0)) {
-                return trimEnd(in, at_lo);
+                return trimEnd(in, at_lo, c.b[at_lo ? 0 : 3] == 0.0);
             }
             return Result::kUndecided;
         }
@@ -544,7 +551,7 @@ class Certifier {
   private:
     /// Excludes a thin slice at the range's start (at_lo) or end by an "outside"
     /// certificate and shrinks the range past it (kTrimmed), or gives up.
-    Result trimEnd(const Interval<R>& in, bool at_lo) {
+    Result trimEnd(const Interval<R>& in, bool at_lo, bool computed_zero) {
         const double width = (in.hi - in.lo) * 0x1p-20;
         const double cut = at_lo ? in.lo + width : in.hi - width;
         if (in.lo < cut && cut < in.hi) {
@@ -562,7 +569,9 @@ class Certifier {
                 return Result::kTrimmed;
             }
         }
-        reason_ = "end";
+        // A computed exact zero is almost surely a true one (exact inputs on a grid):
+        // say so, and spare the double-double pass.
+        reason_ = computed_zero ? "end zero" : "end";
         return Result::kGiveUp;
     }
 
@@ -680,8 +689,9 @@ CertifiedOutcome certify(const std::array<Vec3, 4>& start, const std::array<Vec3
                          double t_lo, double t_hi, double tolerance) {
     CertifiedOutcome out =
         certifyPass<Kind, double>(start, end, t_lo, t_hi, tolerance, kMaxIntervals);
-    if (out.verdict != CertifiedOutcome::Verdict::kUndecided ||
-        std::string_view(out.reason) == "overflow") {
+    const std::string_view reason = out.reason;
+    if (out.verdict != CertifiedOutcome::Verdict::kUndecided || reason == "overflow" ||
+        reason == "end zero") {
         return out;
     }
     const int intervals = out.intervals;

@@ -21,7 +21,8 @@ struct CertifiedOutcome {
     /// kUndecided: no contact happens in [t_lo, resume_from); the rest is undecided.
     double resume_from = 0.0;
     int intervals = 0;  ///< time intervals examined (the work done)
-    /// kUndecided: why, for statistics ("budget", "depth", "bracket", "at root", "overflow").
+    /// kUndecided: why, for statistics ("budget", "depth", "bracket", "at root", "end",
+    /// "end zero", "coplanar", "overflow").
     const char* reason = "";
 };
 
