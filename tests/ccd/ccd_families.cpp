@@ -107,7 +107,7 @@ void parallelAtEnd(Random& r, Query& q) {
 
 /// Positions touching at time tc (vertex on the closed triangle, or the segments meeting),
 /// with grid velocities: start = contact - tc v, end = start + v, all exact.
-void touchAt(Random& r, Query& q, double tc, bool zero_motion) {
+void touchAt(Random& r, Query& q, double tc, bool zero_motion, int first_still = 4) {
     Points contact;
     if (q.kind == Kind::kVertexFace) {
         for (int i = 1; i < 4; ++i) {
@@ -134,12 +134,12 @@ void touchAt(Random& r, Query& q, double tc, bool zero_motion) {
         return;
     }
     for (int i = 0; i < 4; ++i) {
-        const int motion = r.uniform(0, 3);
+        const int motion = i >= first_still ? 0 : r.uniform(0, 3);
         const Vec3 v = motion == 0 ? Vec3::Zero() : r.halves();
         q.start[i] = contact[i] - tc * v;
         q.end[i] = q.start[i] + v;
     }
-    if (r.chance(25)) {  // several vertices share one motion
+    if (first_still == 4 && r.chance(25)) {  // several vertices share one motion
         const Vec3 v = q.end[1] - q.start[1];
         for (int i = 2; i < 4; ++i) {
             q.start[i] = contact[i] - tc * v;
@@ -283,6 +283,27 @@ void genericNear(Random& r, Query& q) {
     }
 }
 
+/// An exact grid contact at time k/8 with the vertex (vertex-face) or edge B (edge-edge)
+/// kept still, moved so that the vertex (or b0) is the origin, and that point moved off by
+/// a gap of 2^-30 ... 2^-110 (or not at all): near misses and touches below double and near
+/// double-double resolution, exact in the input (a coordinate 0 + 2^-k is a double).
+void tinyGap(Random& r, Query& q) {
+    const int first_still = q.kind == Kind::kVertexFace ? 0 : 2;
+    touchAt(r, q, eighth(r), false, first_still);
+    const Vec3 shift = -q.start[first_still];  // a grid point: the shift is exact
+    for (Points* side : {&q.start, &q.end}) {
+        for (Vec3& p : *side) {
+            p += shift;
+        }
+    }
+    const int k = r.pick(std::vector<int>{30, 50, 60, 70, 80, 90, 100, 110});
+    if (r.chance(85)) {
+        const Vec3 gap(std::ldexp(r.uniform(-1, 1), -k), std::ldexp(r.uniform(-1, 1), -k),
+                       std::ldexp(r.uniform(-1, 1), -k));
+        q.start[first_still] = q.end[first_still] = gap;
+    }
+}
+
 /// A random symmetry of the grid (axis permutation and sign flips): exact.
 void permuteAxes(Random& r, Query& q) {
     std::array<int, 3> axis{0, 1, 2};
@@ -340,7 +361,8 @@ const std::vector<std::string>& familyNames() {
     static const std::vector<std::string> kNames{
         "grid-halves",  "grid-unit",       "coplanar-motion", "parallel-at-end",
         "touch-at-k/8", "zero-motion",     "near-miss-ulps",  "tangential-double-root",
-        "hourglass",    "touch-at-0-or-1", "generic",         "generic-near"};
+        "hourglass",    "touch-at-0-or-1", "generic",         "generic-near",
+        "tiny-gap"};
     return kNames;
 }
 
@@ -388,8 +410,11 @@ Query generate(uint64_t seed, uint64_t index, int family) {
         case 10:
             generic(r, q);
             break;
-        default:
+        case 11:
             genericNear(r, q);
+            break;
+        default:
+            tinyGap(r, q);
             break;
     }
     permuteAxes(r, q);
