@@ -18,11 +18,7 @@
 #include <cstdio>
 #include <string>
 
-namespace {
-
 using namespace kolize::ccd;
-
-}  // namespace
 
 int main(int argc, char** argv) {
     const std::string path = argc > 1 ? argv[1] : "/usr/share/assimp/models/PLY/cube.ply";

@@ -783,7 +783,7 @@ struct Time {
         if constexpr (std::is_same_v<N, Interval>) {
             // An exact time of the interval pass is num / den with interval num and den:
             // nearly cancelling coefficients can leave that quotient wide, and toi (its lower
-            // end) too early (issue 15's soak: toi 4/15 for a contact at 2/5). Such a time
+            // end) too early (issue 15's soak: toi 4/15 for a contact at ~2/5). Such a time
             // is refined in exact numbers.
             if (exact && upper() - lower() > width) {
                 throw Uncertain{};
