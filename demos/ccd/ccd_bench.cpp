@@ -1,14 +1,18 @@
-/// kolize-ccd-bench [DIR] [--csv FILE] [--sweep FILE] [--repeat N] [--passes N]
+/// kolize-ccd-bench [DIR...] [--csv FILE] [--sweep FILE] [--repeat N] [--passes N]
 ///
-/// Runs every CCD method over a data set laid out as `<scene>/<vertex-face|edge-edge>/*.csv`
-/// (the Sample-Queries format, see assets/ccd-data/Sample-Queries/README.md) and compares
-/// with the ground truth. Prints, per method, data set and kind: false negatives, false
-/// positives, mean and median microseconds per query, overall and split into colliding
-/// and non-colliding queries. `--csv` writes one row per method, data set and kind (plus
-/// `all` rows per method and kind); `--sweep` runs every method at tolerances 1e-8 ... 1e-1
-/// and writes one row per method, tolerance and kind (error against run time). A query's
-/// time is the median over `--passes` passes (default 3) of the mean of `--repeat`
-/// consecutive runs (default 3).
+/// Runs every CCD method over one or more data sets laid out as
+/// `<scene>/<vertex-face|edge-edge>/*.csv` (the Sample-Queries format, see
+/// assets/ccd-data/Sample-Queries/README.md; kolize-ccd-record writes queries of kolize's
+/// own mesh CCD runs in it) and compares with the ground truth. Methods: `cubic` (thesis
+/// baseline), `robust` (default settings) and `robust-search` (RobustArithmetic::
+/// kSearchThenExact, the inclusion search before the exact stage). Prints, per method,
+/// data set and kind: false negatives, false positives, mean and median microseconds per
+/// query, overall and split into colliding (+) and non-colliding (-) queries, and the
+/// percentage the exact stage decided. `--csv` writes one row per method, data set and kind
+/// (plus `all` rows per folder, method and kind); `--sweep` runs every method at tolerances
+/// 1e-8 ... 1e-1 over the first folder and writes one row per method, tolerance and kind.
+/// A query's time is the median over `--passes` passes (default 3) of the mean of
+/// `--repeat` consecutive runs (default 3).
 #include "kolize/narrowphase/ccd_dataset.h"
 
 #include <algorithm>
@@ -44,6 +48,9 @@ Method makeMethod(const std::string& name, std::optional<double> tolerance = std
     }
     RobustSettings s;
     s.tolerance = tolerance.value_or(s.tolerance);
+    if (name == "robust-search") {
+        s.arithmetic = RobustArithmetic::kSearchThenExact;
+    }
     return {name, [s](QueryKind k, const LabeledQuery& q) { return robustQuery(k, q, s); }};
 }
 
@@ -51,11 +58,12 @@ Method makeMethod(const std::string& name, std::optional<double> tolerance = std
 struct Sample {
     bool truth;
     bool hit;
+    bool exact;  ///< the exact stage decided
     double us;
 };
 
 struct Stats {
-    size_t queries = 0, positives = 0, fn = 0, fp = 0;
+    size_t queries = 0, positives = 0, fn = 0, fp = 0, exact = 0;
     double mean = 0, median = 0, mean_pos = 0, median_pos = 0, mean_neg = 0, median_neg = 0;
 };
 
@@ -77,6 +85,7 @@ Stats summarize(const std::vector<Sample>& samples) {
         s.positives += x.truth;
         s.fn += x.truth && !x.hit;
         s.fp += !x.truth && x.hit;
+        s.exact += x.exact;
         all.push_back(x.us);
         (x.truth ? pos : neg).push_back(x.us);
     }
@@ -86,28 +95,38 @@ Stats summarize(const std::vector<Sample>& samples) {
     return s;
 }
 
-/// Timing of one query: `passes` times, the mean of `repeat` consecutive runs; the query's
-/// time is the median over the passes. Passes go over the whole set in turn, so a burst of
-/// load on a shared machine (a preemption costs milliseconds, a query microseconds) spoils
-/// one pass of a few queries, not their reported time.
-std::vector<Sample> runSet(const Method& m, const QuerySet& set, int repeat, int passes) {
-    std::vector<std::vector<double>> times(set.queries.size());
-    std::vector<Sample> out(set.queries.size());
+/// Timing of every method on every query of a set: `passes` times, the mean of `repeat`
+/// consecutive runs; a query's time is the median over the passes. The methods take turns
+/// on each query and the passes go over the whole set in turn, so a burst of load on a
+/// shared machine (a preemption costs milliseconds, a query microseconds) spoils one pass of
+/// a few queries, not their reported time, and hits every method alike.
+std::vector<std::vector<Sample>> runSet(const std::vector<Method>& methods, const QuerySet& set,
+                                        int repeat, int passes) {
+    const size_t n = set.queries.size();
+    std::vector<std::vector<std::vector<double>>> times(methods.size(),
+                                                        std::vector<std::vector<double>>(n));
+    std::vector<std::vector<Sample>> out(methods.size(), std::vector<Sample>(n));
     for (int pass = 0; pass < passes; ++pass) {
-        for (size_t q = 0; q < set.queries.size(); ++q) {
-            CcdResult r;
-            const auto t0 = std::chrono::steady_clock::now();
-            for (int i = 0; i < repeat; ++i) {
-                r = m.run(set.kind, set.queries[q]);
+        for (size_t q = 0; q < n; ++q) {
+            for (size_t m = 0; m < methods.size(); ++m) {
+                CcdResult r;
+                const auto t0 = std::chrono::steady_clock::now();
+                for (int i = 0; i < repeat; ++i) {
+                    r = methods[m].run(set.kind, set.queries[q]);
+                }
+                const auto t1 = std::chrono::steady_clock::now();
+                times[m][q].push_back(std::chrono::duration<double, std::micro>(t1 - t0).count() /
+                                      repeat);
+                out[m][q] = {set.queries[q].collides, r.hit, r.decided_exactly, 0.0};
             }
-            const auto t1 = std::chrono::steady_clock::now();
-            times[q].push_back(std::chrono::duration<double, std::micro>(t1 - t0).count() / repeat);
-            out[q] = {set.queries[q].collides, r.hit, 0.0};
         }
     }
-    for (size_t q = 0; q < out.size(); ++q) {
-        std::nth_element(times[q].begin(), times[q].begin() + passes / 2, times[q].end());
-        out[q].us = times[q][passes / 2];
+    for (size_t m = 0; m < methods.size(); ++m) {
+        for (size_t q = 0; q < n; ++q) {
+            std::nth_element(times[m][q].begin(), times[m][q].begin() + passes / 2,
+                             times[m][q].end());
+            out[m][q].us = times[m][q][passes / 2];
+        }
     }
     return out;
 }
@@ -121,15 +140,33 @@ std::string defaultDir() {
 }
 
 int usage() {
-    std::cerr << "usage: kolize-ccd-bench [DIR] [--csv FILE] [--sweep FILE] [--repeat N] "
+    std::cerr << "usage: kolize-ccd-bench [DIR...] [--csv FILE] [--sweep FILE] [--repeat N] "
                  "[--passes N]\n";
     return 2;
+}
+
+const char* kHeader = "%-13s %-28s %-11s %6s %5s %4s %4s | %8s %8s | %8s %8s | %8s %8s | %6s\n";
+const char* kRow =
+    "%-13s %-28s %-11s %6zu %5zu %4zu %4zu | %8.3f %8.3f | %8.3f %8.3f | %8.3f %8.3f | %6.2f\n";
+
+void printRow(const std::string& method, const std::string& dataset, const char* kind,
+              const Stats& s, std::ofstream& csv, const std::string& folder) {
+    const double exact = s.queries ? 100.0 * s.exact / s.queries : 0.0;
+    std::printf(kRow, method.c_str(), dataset.c_str(), kind, s.queries, s.positives, s.fn, s.fp,
+                s.mean, s.median, s.mean_pos, s.median_pos, s.mean_neg, s.median_neg, exact);
+    if (csv) {
+        csv << folder << ',' << method << ',' << dataset << ',' << kind << ',' << s.queries << ','
+            << s.positives << ',' << s.fn << ',' << s.fp << ',' << s.mean << ',' << s.median << ','
+            << s.mean_pos << ',' << s.median_pos << ',' << s.mean_neg << ',' << s.median_neg << ','
+            << exact << '\n';
+    }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string dir, csv_path, sweep_path;
+    std::vector<std::string> dirs;
+    std::string csv_path, sweep_path;
     int repeat = 3, passes = 3;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -145,95 +182,92 @@ int main(int argc, char** argv) {
             } else {
                 passes = std::max(1, std::atoi(v.c_str()));
             }
-        } else if (!a.empty() && a[0] != '-' && dir.empty()) {
-            dir = a;
+        } else if (!a.empty() && a[0] != '-') {
+            dirs.push_back(a);
         } else {
             return usage();
         }
     }
-    if (dir.empty()) {
-        dir = defaultDir();
+    if (dirs.empty()) {
+        dirs.push_back(defaultDir());
     }
-    std::vector<QuerySet> sets;
-    try {
-        sets = readQueryFolder(dir);
-    } catch (const std::exception& e) {
-        std::cerr << "kolize-ccd-bench: " << e.what() << "\n";
-        return 1;
+    std::vector<std::vector<QuerySet>> folders;
+    for (const std::string& dir : dirs) {
+        try {
+            folders.push_back(readQueryFolder(dir));
+        } catch (const std::exception& e) {
+            std::cerr << "kolize-ccd-bench: " << e.what() << "\n";
+            return 1;
+        }
     }
-    size_t total = 0;
-    for (const auto& s : sets) {
-        total += s.queries.size();
-    }
-    std::printf(
-        "data: %s (%zu queries in %zu sets); a query's time: median over %d passes of the "
-        "mean of %d runs\n\n",
-        dir.c_str(), total, sets.size(), passes, repeat);
-
     std::ofstream csv;
     if (!csv_path.empty()) {
         csv.open(csv_path);
-        csv << "method,dataset,kind,queries,positives,false_negatives,false_positives,mean_us,"
-               "median_us\n";
+        csv << "folder,method,dataset,kind,queries,positives,false_negatives,false_positives,"
+               "mean_us,median_us,mean_colliding_us,median_colliding_us,mean_noncolliding_us,"
+               "median_noncolliding_us,exact_percent\n";
     }
-    const char* header = "%-8s %-28s %-11s %6s %5s %4s %4s | %8s %8s | %8s %8s | %8s %8s\n";
-    const char* row =
-        "%-8s %-28s %-11s %6zu %5zu %4zu %4zu | %8.3f %8.3f | %8.3f %8.3f | %8.3f %8.3f\n";
-    std::printf(header, "method", "dataset", "kind", "N", "pos", "FN", "FP", "mean_us", "med_us",
-                "mean+", "med+", "mean-", "med-");
-    for (const std::string name : {"cubic", "robust"}) {
-        const Method m = makeMethod(name);
-        std::vector<Sample> per_kind[2];
-        for (const QuerySet& set : sets) {
-            const auto samples = runSet(m, set, repeat, passes);
-            auto& acc = per_kind[set.kind == QueryKind::kEdgeEdge];
-            acc.insert(acc.end(), samples.begin(), samples.end());
-            const Stats s = summarize(samples);
-            std::printf(row, name.c_str(), set.scene.c_str(), kindName(set.kind), s.queries,
-                        s.positives, s.fn, s.fp, s.mean, s.median, s.mean_pos, s.median_pos,
-                        s.mean_neg, s.median_neg);
-            if (csv) {
-                csv << name << ',' << set.scene << ',' << kindName(set.kind) << ',' << s.queries
-                    << ',' << s.positives << ',' << s.fn << ',' << s.fp << ',' << s.mean << ','
-                    << s.median << '\n';
-            }
-        }
-        std::vector<Sample> both;
-        for (int k = 0; k < 2; ++k) {
-            both.insert(both.end(), per_kind[k].begin(), per_kind[k].end());
-            const QueryKind kind = k ? QueryKind::kEdgeEdge : QueryKind::kVertexFace;
-            const Stats s = summarize(per_kind[k]);
-            std::printf(row, name.c_str(), "all", kindName(kind), s.queries, s.positives, s.fn,
-                        s.fp, s.mean, s.median, s.mean_pos, s.median_pos, s.mean_neg, s.median_neg);
-            if (csv) {
-                csv << name << ",all," << kindName(kind) << ',' << s.queries << ',' << s.positives
-                    << ',' << s.fn << ',' << s.fp << ',' << s.mean << ',' << s.median << '\n';
-            }
-        }
-        const Stats s = summarize(both);
-        std::printf(row, name.c_str(), "all", "both", s.queries, s.positives, s.fn, s.fp, s.mean,
-                    s.median, s.mean_pos, s.median_pos, s.mean_neg, s.median_neg);
-        std::printf("\n");
+    std::vector<Method> methods;
+    for (const char* name : {"cubic", "robust", "robust-search"}) {
+        methods.push_back(makeMethod(name));
     }
     std::printf(
-        "N: queries, pos: colliding queries (ground truth), FN/FP: false negatives/"
-        "positives;\ntimes in microseconds per query: all, colliding (+), "
-        "non-colliding (-). Default settings:\ncubic tolerance %g (scene units), robust "
-        "tolerance %g (hand-off ratio; its answers are exact at any tolerance).\n",
+        "a query's time: median over %d passes of the mean of %d runs; methods take turns\n",
+        passes, repeat);
+    for (size_t f = 0; f < folders.size(); ++f) {
+        const std::vector<QuerySet>& sets = folders[f];
+        size_t total = 0;
+        for (const auto& set : sets) {
+            total += set.queries.size();
+        }
+        std::printf("\ndata: %s (%zu queries in %zu sets)\n", dirs[f].c_str(), total, sets.size());
+        std::printf(kHeader, "method", "dataset", "kind", "N", "pos", "FN", "FP", "mean_us",
+                    "med_us", "mean+", "med+", "mean-", "med-", "exact%");
+        std::vector<std::vector<Sample>> per_kind[2];
+        std::vector<std::vector<std::pair<std::string, Stats>>> rows(methods.size());
+        for (int k = 0; k < 2; ++k) {
+            per_kind[k].resize(methods.size());
+        }
+        for (const QuerySet& set : sets) {
+            const auto samples = runSet(methods, set, repeat, passes);
+            for (size_t m = 0; m < methods.size(); ++m) {
+                auto& acc = per_kind[set.kind == QueryKind::kEdgeEdge][m];
+                acc.insert(acc.end(), samples[m].begin(), samples[m].end());
+                printRow(methods[m].name, set.scene, kindName(set.kind), summarize(samples[m]), csv,
+                         dirs[f]);
+            }
+        }
+        for (size_t m = 0; m < methods.size(); ++m) {
+            std::vector<Sample> both;
+            for (int k = 0; k < 2; ++k) {
+                both.insert(both.end(), per_kind[k][m].begin(), per_kind[k][m].end());
+                printRow(methods[m].name, "all",
+                         kindName(k ? QueryKind::kEdgeEdge : QueryKind::kVertexFace),
+                         summarize(per_kind[k][m]), csv, dirs[f]);
+            }
+            printRow(methods[m].name, "all", "both", summarize(both), csv, dirs[f]);
+        }
+    }
+    std::printf(
+        "\nN: queries, pos: colliding queries (ground truth), FN/FP: false negatives/"
+        "positives;\ntimes in microseconds per query: all, colliding (+), non-colliding (-); "
+        "exact%%: decided by the exact stage.\nDefault settings: cubic tolerance %g (scene "
+        "units); robust-search hand-off tolerance %g (its answers are exact at any tolerance).\n",
         CubicSettings{}.tolerance, RobustSettings{}.tolerance);
 
+    const std::vector<QuerySet>& sets = folders.front();
     if (!sweep_path.empty()) {
         std::ofstream sweep(sweep_path);
         sweep << "method,tolerance,kind,queries,false_negatives,false_positives,mean_us\n";
-        std::printf("\ntolerance sweep (all data sets)\n%-8s %9s %-11s %5s %5s %9s\n", "method",
-                    "tolerance", "kind", "FN", "FP", "mean_us");
-        for (const std::string name : {"cubic", "robust"}) {
+        std::printf("\ntolerance sweep (%s)\n%-13s %9s %-11s %5s %5s %9s\n", dirs.front().c_str(),
+                    "method", "tolerance", "kind", "FN", "FP", "mean_us");
+        for (const std::string name : {"cubic", "robust-search"}) {
             for (int e = -8; e <= -1; ++e) {
                 const double tol = std::pow(10.0, e);
                 const Method m = makeMethod(name, tol);
                 std::vector<Sample> per_kind[3];
                 for (const QuerySet& set : sets) {
-                    const auto samples = runSet(m, set, repeat, passes);
+                    const auto samples = runSet({m}, set, repeat, passes).front();
                     auto& acc = per_kind[set.kind == QueryKind::kEdgeEdge];
                     acc.insert(acc.end(), samples.begin(), samples.end());
                     per_kind[2].insert(per_kind[2].end(), samples.begin(), samples.end());
@@ -243,8 +277,8 @@ int main(int argc, char** argv) {
                         k == 2 ? "both"
                                : kindName(k ? QueryKind::kEdgeEdge : QueryKind::kVertexFace);
                     const Stats s = summarize(per_kind[k]);
-                    std::printf("%-8s %9.0e %-11s %5zu %5zu %9.3f\n", name.c_str(), tol, kind, s.fn,
-                                s.fp, s.mean);
+                    std::printf("%-13s %9.0e %-11s %5zu %5zu %9.3f\n", name.c_str(), tol, kind,
+                                s.fn, s.fp, s.mean);
                     sweep << name << ',' << tol << ',' << kind << ',' << s.queries << ',' << s.fn
                           << ',' << s.fp << ',' << s.mean << '\n';
                 }

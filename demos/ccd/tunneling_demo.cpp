@@ -11,6 +11,8 @@
 /// The discrete overlap test is the exact test for two axis-aligned boxes (both stay
 /// axis-aligned: pure translation), i.e. the cheapest possible discrete check; a general
 /// mesh overlap test would cost more per substep.
+#include "ccd_scenes.h"
+
 #include "kolize/narrowphase/mesh_ccd.h"
 
 #include <chrono>
@@ -23,36 +25,13 @@
 namespace {
 
 using namespace kolize::ccd;
-
-/// Axis-aligned box [lo, hi] as a closed 12-triangle mesh, translated by `motion`.
-MovingMesh boxMesh(const Vec3& lo, const Vec3& hi, const Vec3& motion) {
-    MovingMesh m;
-    for (int i = 0; i < 8; ++i) {
-        const Vec3 p(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-        m.start.push_back(p);
-        m.end.push_back(p + motion);
-    }
-    m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-    return m;
-}
+using scenes::boxMesh;
+using scenes::Random;
+using Trial = scenes::ThinWall::Trial;
 
 bool boxesOverlap(const Vec3& lo_a, const Vec3& hi_a, const Vec3& lo_b, const Vec3& hi_b) {
     return (lo_a.array() <= hi_b.array()).all() && (lo_b.array() <= hi_a.array()).all();
 }
-
-/// Deterministic uniform numbers in [0, 1) (64-bit LCG, top 53 bits).
-struct Random {
-    uint64_t state = 0x853c49e6748fea9bull;
-    double next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return static_cast<double>(state >> 11) * 0x1p-53;
-    }
-};
-
-struct Trial {
-    Vec3 lo, hi, motion;
-};
 
 }  // namespace
 
@@ -66,9 +45,10 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    const double edge = 0.2;
-    const Vec3 plate_lo(0, -1, -1), plate_hi(0.01, 1, 1);
-    const MovingMesh plate = boxMesh(plate_lo, plate_hi, Vec3::Zero());
+    const scenes::ThinWall wall;
+    const double edge = scenes::ThinWall::kEdge;
+    const Vec3 &plate_lo = wall.plate_lo, &plate_hi = wall.plate_hi;
+    const MovingMesh& plate = wall.plate;
     const std::vector<double> speeds{0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10};
     const std::vector<int> substeps{1, 2, 4, 8, 16};
     constexpr int kTrials = 200;
@@ -91,10 +71,7 @@ int main(int argc, char** argv) {
     for (double v : speeds) {
         std::vector<Trial> trials;
         for (int i = 0; i < kTrials; ++i) {
-            // Contact starts at tau in [0, 1): the cube's front face reaches x = 0 then.
-            const double tau = random.next();
-            const Vec3 lo(-edge - tau * v, random.next() - 0.5, random.next() - 0.5);
-            trials.push_back({lo, lo + Vec3::Constant(edge), Vec3(v, 0, 0)});
+            trials.push_back(scenes::ThinWall::trial(v, random));
         }
         std::printf("%8.2f", v);
         for (size_t m = 0; m <= substeps.size(); ++m) {

@@ -1,5 +1,6 @@
 #include "kolize/narrowphase/ccd.h"
 
+#include "ccd_certified.h"
 #include "ccd_exact.h"
 
 #include <Eigen/Geometry>
@@ -7,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace kolize::ccd {
@@ -216,6 +219,8 @@ std::array<double, 3> crossAt(const std::array<std::array<double, 3>, 4>& x0,
 struct VertexFaceF {
     static constexpr bool kTriangleDomain = true;
     static constexpr auto kExact = detail::vertexFaceExact;
+    static constexpr auto kCertified = detail::vertexFaceCertified;
+    static constexpr const char* kName = "vertexFaceRobust";
     /// Face normal at time t (any direction is valid for exclusion; this one is the
     /// direction in which a near-coplanar F image is thin).
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
@@ -248,6 +253,8 @@ struct VertexFaceF {
 struct EdgeEdgeF {
     static constexpr bool kTriangleDomain = false;
     static constexpr auto kExact = detail::edgeEdgeExact;
+    static constexpr auto kCertified = detail::edgeEdgeCertified;
+    static constexpr const char* kName = "edgeEdgeRobust";
     /// Common normal of both edges at time t.
     static std::array<double, 3> normal(const std::array<std::array<double, 3>, 4>& x0,
                                         const std::array<std::array<double, 3>, 4>& dx, double t) {
@@ -299,9 +306,88 @@ bool excludedAlongNormal(std::array<double, 3> n, const Corners& f,
     return lo - bound > 0.0 || hi + bound < 0.0;
 }
 
+/// Smallest effective toi_tolerance: the spacing of doubles just below 1.
+constexpr double kMinToiTolerance = 0x1p-52;
+
+/// Refuses settings without a defined meaning (see RobustSettings) and non-finite input.
+void validate(const char* function, const std::array<Vec3, 4>& start,
+              const std::array<Vec3, 4>& end, const RobustSettings& settings) {
+    auto fail = [&](const std::string& what) {
+        throw std::invalid_argument(std::string(function) + ": " + what);
+    };
+    if (!(settings.toi_tolerance > 0.0)) {
+        fail("RobustSettings::toi_tolerance must be > 0, got " +
+             std::to_string(settings.toi_tolerance));
+    }
+    if (std::isnan(settings.min_time) || std::isnan(settings.max_time)) {
+        fail("RobustSettings::min_time and max_time must not be NaN");
+    }
+    // x - x is 0 for a finite x and NaN otherwise: one test for all 24 in the common case.
+    double probe = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        probe += (start[i] - start[i]).sum() + (end[i] - end[i]).sum();
+    }
+    if (probe == 0.0) {
+        return;
+    }
+    for (int side = 0; side < 2; ++side) {
+        for (int i = 0; i < 4; ++i) {
+            const Vec3& p = side ? end[i] : start[i];
+            if (!p.allFinite()) {
+                fail(std::string(side ? "end" : "start") + "[" + std::to_string(i) +
+                     "] is not finite");
+            }
+        }
+    }
+}
+
 template <class Evaluator>
 CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                     const RobustSettings& settings) {
+    validate(Evaluator::kName, start, end, settings);
+    CcdResult result;
+    const double t_max = std::clamp(settings.max_time, 0.0, 1.0);
+    const double t_min = std::clamp(settings.min_time, 0.0, 1.0);
+    if (t_min > t_max) {
+        return result;  // Empty range.
+    }
+    // Half the tolerance for the exact stage, whose toi is one rounding below its bracket:
+    // t* <= toi + 2^-53 + tolerance / 2 <= toi + tolerance.
+    // (At most 1: any wider bracket of a time in [0, 1] is as good, and stays finite.)
+    const double exact_tolerance =
+        std::min(0.5 * std::max(settings.toi_tolerance, kMinToiTolerance), 1.0);
+    // The exact stage over [t0, max_time] (no contact happens before t0).
+    auto decideExactly = [&](double t0, detail::Arithmetic arithmetic) {
+        const detail::ExactContact exact =
+            Evaluator::kExact(start, end, t0, t_max, exact_tolerance, arithmetic);
+        result.hit = exact.hit;
+        result.toi = exact.hit ? exact.toi : 1.0;
+        result.decided_exactly = true;
+        return result;
+    };
+    if (settings.arithmetic == RobustArithmetic::kExactOnly) {
+        return decideExactly(t_min, detail::Arithmetic::kExactOnly);
+    }
+    if (settings.arithmetic == RobustArithmetic::kCertified) {
+        const detail::CertifiedOutcome certified = Evaluator::kCertified(
+            start, end, t_min, t_max, std::max(settings.toi_tolerance, kMinToiTolerance));
+        result.boxes = certified.intervals;
+        if (certified.verdict == detail::CertifiedOutcome::Verdict::kUndecided) {
+            // What the certificates leave is degenerate (an exact touch, coplanar motion, a
+            // double root): the inclusion search would only delay the exact stage.
+            return decideExactly(certified.resume_from, detail::Arithmetic::kFiltered);
+        }
+        result.hit = certified.verdict == detail::CertifiedOutcome::Verdict::kContact;
+        result.toi = result.hit ? certified.toi : 1.0;
+        return result;
+    }
+    double largest = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        largest = std::max({largest, start[i].cwiseAbs().maxCoeff(), end[i].cwiseAbs().maxCoeff()});
+    }
+    if (largest > kMaxCoordinate) {
+        return decideExactly(t_min, detail::Arithmetic::kFiltered);  // the search's bound
+    }
     std::array<std::array<double, 3>, 4> x0{}, dx{};
     std::array<double, 3> eps{};
     for (int k = 0; k < 3; ++k) {
@@ -315,9 +401,6 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     }
 
     const Evaluator evaluate;
-    CcdResult result;
-    const double t_max = std::clamp(settings.max_time, 0.0, 1.0);
-    const double t_min = std::clamp(settings.min_time, 0.0, t_max);
     std::priority_queue<Box, std::vector<Box>, LaterBox> queue;
     // Any double t is evaluated exactly as given, and a rounded midpoint still lies in
     // [t0, t1], so boxes keep covering [min_time, max_time] without dyadic end points.
@@ -325,13 +408,6 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
     Corners f;
     // Boxes are examined in order of t0 and every box before was excluded, so no contact
     // happens before t0: the exact decision only needs [t0, max_time].
-    auto decideExactly = [&](double t0) {
-        const detail::ExactContact exact = Evaluator::kExact(
-            start, end, t0, t_max, settings.toi_tolerance, detail::Arithmetic::kFiltered);
-        result.hit = exact.hit;
-        result.toi = exact.hit ? exact.toi : 1.0;
-        return result;
-    };
     double handoff_width = -1.0;  // set from the first (whole-domain) box
     while (!queue.empty()) {
         const Box b = queue.top();
@@ -341,7 +417,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         }
         if (++result.boxes > settings.max_boxes) {
             result.budget_exhausted = true;
-            return decideExactly(b.t0);
+            return decideExactly(b.t0, detail::Arithmetic::kFiltered);
         }
         evaluate(x0, dx, b, f);
         bool excluded = false;
@@ -368,7 +444,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
             handoff_width = settings.tolerance * width;
         }
         if (width <= handoff_width) {
-            return decideExactly(b.t0);
+            return decideExactly(b.t0, detail::Arithmetic::kFiltered);
         }
         // Split the dimension along which F varies most (largest change between the
         // corner pairs that differ only in that dimension). Time is favoured (x4): a
@@ -399,7 +475,7 @@ CcdResult robustCcd(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>&
         if (variation[d] < 0.0) {
             // Cannot split further without losing exactness: the exact decision takes over.
             result.budget_exhausted = true;
-            return decideExactly(b.t0);
+            return decideExactly(b.t0, detail::Arithmetic::kFiltered);
         }
         Box lo = b, hi = b;
         lo.depth = hi.depth = b.depth + 1;
@@ -440,11 +516,19 @@ CcdResult edgeEdgeCubic(const EdgeEdgeQuery& q, const CubicSettings& settings) {
 }
 
 CcdResult vertexFaceRobust(const VertexFaceQuery& q, const RobustSettings& settings) {
-    return robustCcd<VertexFaceF>(q.start, q.end, settings);
+    const CcdResult r = robustCcd<VertexFaceF>(q.start, q.end, settings);
+    if (settings.observer) {
+        settings.observer->observe(false, q.start, q.end, settings, r);
+    }
+    return r;
 }
 
 CcdResult edgeEdgeRobust(const EdgeEdgeQuery& q, const RobustSettings& settings) {
-    return robustCcd<EdgeEdgeF>(q.start, q.end, settings);
+    const CcdResult r = robustCcd<EdgeEdgeF>(q.start, q.end, settings);
+    if (settings.observer) {
+        settings.observer->observe(true, q.start, q.end, settings, r);
+    }
+    return r;
 }
 
 }  // namespace kolize::ccd

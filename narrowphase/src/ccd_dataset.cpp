@@ -1,6 +1,10 @@
 #include "kolize/narrowphase/ccd_dataset.h"
 
+#include <gmp.h>
+
 #include <algorithm>
+#include <cctype>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -17,41 +21,70 @@ namespace fs = std::filesystem;
     throw std::runtime_error(path + ":" + std::to_string(line) + ": " + what);
 }
 
-/// A decimal integer as a double, or fail if it does not convert exactly. strtod rounds
-/// correctly and "%.0f" prints a double's exact integer value, so a round trip through
-/// both proves exactness (numbers here exceed 64-bit integers, e.g. denominators 2^107).
-double exactInteger(const std::string& text, const std::string& path, size_t line) {
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || !std::isfinite(value)) {
+/// An integer's decimal digits (optional sign), or fail.
+void parseInteger(const std::string& text, mpz_t out, const std::string& path, size_t line) {
+    const size_t sign_chars = !text.empty() && (text[0] == '-' || text[0] == '+') ? 1 : 0;
+    const bool plain = text.size() > sign_chars &&
+                       std::all_of(text.begin() + sign_chars, text.end(),
+                                   [](unsigned char c) { return std::isdigit(c) != 0; });
+    if (!plain || mpz_set_str(out, text.c_str() + (text[0] == '+' ? 1 : 0), 10) != 0) {
         fail(path, line, "expected an integer, got '" + text + "'");
     }
-    char buffer[400];
-    std::snprintf(buffer, sizeof buffer, "%.0f", value);
-    std::string canonical = text[0] == '+' ? text.substr(1) : text;
-    if (canonical == "-0") {
-        canonical = "0";
-    }
-    if (canonical != buffer && !(value == 0.0 && canonical == "0")) {
-        fail(path, line, "integer " + text + " is not exactly representable as a double");
-    }
-    return value;
 }
 
-/// num / den as a double, refusing anything that would round.
+/// GMP numbers of one conversion, released on every path.
+struct RatioScratch {
+    mpz_t num, den;
+    mpq_t value, back;
+    RatioScratch() {
+        mpz_inits(num, den, nullptr);
+        mpq_inits(value, back, nullptr);
+    }
+    ~RatioScratch() {
+        mpz_clears(num, den, nullptr);
+        mpq_clears(value, back, nullptr);
+    }
+    RatioScratch(const RatioScratch&) = delete;
+    RatioScratch& operator=(const RatioScratch&) = delete;
+};
+
+/// num / den as a double, refusing anything that would round. Both are integers of any
+/// size (GMP): the coordinate must equal a double exactly, e.g. 3 / 2^1074 or 6 / 4.
 double exactRatio(const std::string& num_text, const std::string& den_text, const std::string& path,
                   size_t line) {
-    const double num = exactInteger(num_text, path, line);
-    const double den = exactInteger(den_text, path, line);
-    int exponent = 0;
-    if (!(den > 0.0) || std::frexp(den, &exponent) != 0.5) {
-        fail(path, line, "denominator is not a positive power of two");
+    RatioScratch r;
+    parseInteger(num_text, r.num, path, line);
+    parseInteger(den_text, r.den, path, line);
+    if (mpz_sgn(r.den) <= 0) {
+        fail(path, line, "denominator " + den_text + " is not positive");
     }
-    const double value = std::ldexp(num, 1 - exponent);  // den = 2^(exponent - 1)
-    if (std::ldexp(value, exponent - 1) != num) {
-        fail(path, line, "coordinate underflows a double");
+    mpq_set_num(r.value, r.num);
+    mpq_set_den(r.value, r.den);
+    mpq_canonicalize(r.value);
+    const double x = mpq_get_d(r.value);  // truncated; exact when the value is a double
+    mpq_set_d(r.back, x);
+    if (!std::isfinite(x) || !mpq_equal(r.back, r.value)) {
+        fail(path, line,
+             "coordinate " + num_text + "/" + den_text +
+                 " is not exactly representable as a double");
     }
-    return value;
+    return x;
+}
+
+/// x exactly as "num,den" (den a power of two).
+std::string exactText(double x) {
+    mpq_t q;
+    mpq_init(q);
+    mpq_set_d(q, x);
+    char* num = mpz_get_str(nullptr, 10, mpq_numref(q));
+    char* den = mpz_get_str(nullptr, 10, mpq_denref(q));
+    std::string text = std::string(num) + "," + den;
+    void (*release)(void*, size_t);
+    mp_get_memory_functions(nullptr, nullptr, &release);
+    release(num, std::strlen(num) + 1);
+    release(den, std::strlen(den) + 1);
+    mpq_clear(q);
+    return text;
 }
 
 }  // namespace
@@ -103,6 +136,26 @@ std::vector<LabeledQuery> readQueryCsv(const std::string& path) {
         fail(path, line, "row count is not a multiple of 8");
     }
     return queries;
+}
+
+void writeQueryCsv(const std::string& path, const std::vector<LabeledQuery>& queries) {
+    std::ofstream out(path);
+    if (!out) {
+        throw std::runtime_error("cannot write " + path);
+    }
+    for (const LabeledQuery& q : queries) {
+        for (int row = 0; row < 8; ++row) {
+            const Vec3& p = row < 4 ? q.start[row] : q.end[row - 4];
+            if (!p.allFinite()) {
+                throw std::runtime_error("writeQueryCsv: a coordinate is not finite");
+            }
+            out << exactText(p.x()) << ',' << exactText(p.y()) << ',' << exactText(p.z()) << ','
+                << (q.collides ? 1 : 0) << '\n';
+        }
+    }
+    if (!out) {
+        throw std::runtime_error("error writing " + path);
+    }
 }
 
 std::vector<QuerySet> readQueryFolder(const std::string& root) {

@@ -780,6 +780,15 @@ struct Time {
         while (!exact && widerThan(lo, hi, width)) {
             bisect();
         }
+        if constexpr (std::is_same_v<N, Interval>) {
+            // An exact time of the interval pass is num / den with interval num and den:
+            // nearly cancelling coefficients can leave that quotient wide, and toi (its lower
+            // end) too early (issue 15's soak: toi 4/15 for a contact at ~2/5). Such a time
+            // is refined in exact numbers.
+            if (exact && upper() - lower() > width) {
+                throw Uncertain{};
+            }
+        }
     }
 
     double lower() const { return exact ? lowerQuotient(num, den) : lowerQuotient(lo, N(1)); }
@@ -981,6 +990,11 @@ Roots<N> roots(const Poly<N>& events, const N& a, const N& b) {
         while (sign_b == 0 && p.n > 1) {
             p = deflate(p, b);
             sign_b = signAt(p, b);
+        }
+        if (root_at_b) {
+            // Dividing by (t - b), negative on [a, b), flipped the sign at a (issue 15: the
+            // stale sign sent the bisection of an interior root to the wrong end).
+            sign_a = signAt(p, a);
         }
         if (p.n >= 2) {
             isolateBernstein(p, a, sign_a, b, sign_b, 0, out);
@@ -1307,6 +1321,8 @@ template <class N>
 ExactContact vertexFaceExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                              double t_lo, double t_hi, double toi_tolerance,
                              Arithmetic arithmetic) {
+    assert(0.0 < toi_tolerance && toi_tolerance <= 1.0 && 0.0 <= t_lo && t_lo <= t_hi &&
+           t_hi <= 1.0);
     // Both passes need upward rounding (the exact one filters with intervals too); they are
     // not inlined, so no floating-point operation can move across the mode switch.
     const UpwardRounding upward;
@@ -1321,6 +1337,8 @@ ExactContact vertexFaceExact(const std::array<Vec3, 4>& start, const std::array<
 
 ExactContact edgeEdgeExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                            double t_lo, double t_hi, double toi_tolerance, Arithmetic arithmetic) {
+    assert(0.0 < toi_tolerance && toi_tolerance <= 1.0 && 0.0 <= t_lo && t_lo <= t_hi &&
+           t_hi <= 1.0);
     const UpwardRounding upward;
     if (arithmetic == Arithmetic::kFiltered) {
         try {

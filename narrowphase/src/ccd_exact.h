@@ -25,7 +25,8 @@ struct ExactContact {
 enum class Arithmetic { kFiltered, kExactOnly };
 
 /// Vertex `start[0]`/`end[0]` against triangle `start[1..3]`/`end[1..3]`, exact, for
-/// t in [t_lo, t_hi] with 0 <= t_lo <= t_hi <= 1. Any finite double coordinates.
+/// t in [t_lo, t_hi] with 0 <= t_lo <= t_hi <= 1 and 0 < toi_tolerance <= 1 (asserted).
+/// Any finite double coordinates.
 ExactContact vertexFaceExact(const std::array<Vec3, 4>& start, const std::array<Vec3, 4>& end,
                              double t_lo, double t_hi, double toi_tolerance,
                              Arithmetic arithmetic = Arithmetic::kFiltered);

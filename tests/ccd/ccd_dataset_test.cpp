@@ -6,7 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <gmpxx.h>
+
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -42,6 +46,75 @@ TEST(CcdDataset, ReaderRefusesInexactCoordinates) {
     }
     EXPECT_THROW(readQueryCsv(path.string()), std::runtime_error);
     std::filesystem::remove(path);
+}
+
+/// Writes 8 copies of `row` (one query) and reads them back.
+std::vector<LabeledQuery> readRows(const std::string& row) {
+    const auto path = std::filesystem::temp_directory_path() / "kolize_ccd_rows.csv";
+    {
+        std::ofstream out(path);
+        for (int i = 0; i < 8; ++i) {
+            out << row << "\n";
+        }
+    }
+    struct Remove {
+        std::filesystem::path p;
+        ~Remove() { std::filesystem::remove(p); }
+    } remove{path};
+    return readQueryCsv(path.string());
+}
+
+// Issue 15: denominators above 2^1023 (coordinates below about 2^-970) did not fit a double
+// and were refused with a misleading message. They are big integers now.
+TEST(CcdDataset, ReaderParsesArbitraryExactDenominators) {
+    const std::string two_1074 = mpz_class(mpz_class(1) << 1074).get_str();
+    // 3 / 2^1074 = 3 times the smallest subnormal; 6 / 4 = 3 / 2 (not in lowest terms).
+    const auto q = readRows("3," + two_1074 + ",6,4,-0,1,1");
+    ASSERT_EQ(q.size(), 1u);
+    EXPECT_EQ(q[0].start[0].x(), 3 * std::numeric_limits<double>::denorm_min());
+    EXPECT_EQ(q[0].start[0].y(), 1.5);
+    EXPECT_EQ(q[0].start[0].z(), 0.0);
+    EXPECT_TRUE(q[0].collides);
+    // Below the smallest subnormal, a third, a zero or negative denominator, not a number.
+    for (const std::string& bad : std::vector<std::string>{
+             "1," + two_1074 + "0,0,1,0,1,0", "1,3,0,1,0,1,0", "1,0,0,1,0,1,0", "1,-2,0,1,0,1,0",
+             "1,2,x,1,0,1,0", "1,2,,1,0,1,0", "1,2,0,1,0,1,2"}) {
+        try {
+            readRows(bad);
+            ADD_FAILURE() << "accepted " << bad.substr(0, 40);
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find(":1:"), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(CcdDataset, WriterRoundTripsEveryDoubleExactly) {
+    std::mt19937_64 rng(7);
+    std::vector<LabeledQuery> queries(50);
+    for (size_t n = 0; n < queries.size(); ++n) {
+        for (int i = 0; i < 4; ++i) {
+            for (int k = 0; k < 3; ++k) {
+                double x;
+                do {  // any finite double: subnormals, huge values, negative zero
+                    const uint64_t bits = rng();
+                    std::memcpy(&x, &bits, sizeof x);
+                } while (!std::isfinite(x));
+                queries[n].start[i][k] = x;
+                queries[n].end[i][k] = n % 3 == 0 ? std::numeric_limits<double>::denorm_min() : -x;
+            }
+        }
+        queries[n].collides = n % 2;
+    }
+    const auto path = std::filesystem::temp_directory_path() / "kolize_ccd_roundtrip.csv";
+    writeQueryCsv(path.string(), queries);
+    const auto back = readQueryCsv(path.string());
+    std::filesystem::remove(path);
+    ASSERT_EQ(back.size(), queries.size());
+    for (size_t n = 0; n < queries.size(); ++n) {
+        EXPECT_EQ(back[n].start, queries[n].start) << n;
+        EXPECT_EQ(back[n].end, queries[n].end) << n;
+        EXPECT_EQ(back[n].collides, queries[n].collides) << n;
+    }
 }
 
 TEST(CcdDataset, RobustHasNoFalseNegativesAndAtMostOnePercentFalsePositives) {

@@ -32,11 +32,18 @@ struct QuerySet {
     std::vector<LabeledQuery> queries;
 };
 
-/// Reads one CSV file. Throws std::runtime_error when a row is malformed, a denominator
-/// is not a positive power of two, a coordinate is not exactly representable as a double,
-/// or the row count is not a multiple of 8 -- the robust method's guarantee is about the
-/// exact input, so the reader refuses to round silently.
+/// Reads one CSV file. Numerators and denominators are integers of any size (read with
+/// GMP, e.g. denominators 2^1074 of subnormal coordinates). Throws std::runtime_error,
+/// naming the file and line, when a row is malformed, a denominator is not positive, a
+/// coordinate is not exactly representable as a double, or the row count is not a multiple
+/// of 8 -- the robust method's guarantee is about the exact input, so the reader refuses to
+/// round silently.
 std::vector<LabeledQuery> readQueryCsv(const std::string& path);
+
+/// Writes queries in the same format, every coordinate exactly (denominators are powers of
+/// two). Throws std::runtime_error when the file cannot be written or a coordinate is not
+/// finite.
+void writeQueryCsv(const std::string& path, const std::vector<LabeledQuery>& queries);
 
 /// Reads every `<scene>/<kind>/*.csv` found under `root` (at any depth), one QuerySet per
 /// scene and kind, in path order; the scene is the kind folder's parent relative to
