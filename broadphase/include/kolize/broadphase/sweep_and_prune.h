@@ -125,8 +125,8 @@ class SweepAndPrune {
 
     /// Moves object `id`: its endpoints swap their way to the new values.
     void update(ObjectId id, const Box& box) {
-        boxes_[id] = box;
         if (state_[id] == State::Pending) {
+            boxes_[id] = box;  // sorted objects' boxes live in their endpoints
             return;
         }
         for (int axis = 0; axis < D; ++axis) {
@@ -226,7 +226,7 @@ class SweepAndPrune {
         for (std::size_t at = 0; at < edges.size() && !(edges[at].value() > box.hi[0]); ++at) {
             const ObjectId id = edges[at].id();
             if (!edges[at].isMax() && state_[id] == State::Sorted &&
-                !(boxes_[id].hi[0] < box.lo[0])) {
+                !(edges[at_[id][1]].value() < box.lo[0])) {
                 visit(id);
             }
         }
@@ -264,9 +264,9 @@ class SweepAndPrune {
                             axes_[axis][at].isMax() != (end == 1)) {
                             fail("endpoint position of object " + std::to_string(id) + " wrong");
                         }
-                        const Scalar value = end == 0 ? boxes_[id].lo[axis] : boxes_[id].hi[axis];
-                        if (!(axes_[axis][at].value() == value)) {
-                            fail("endpoint value of object " + std::to_string(id) + " stale");
+                        if (end == 1 &&
+                            axes_[axis][at].value() < axes_[axis][at_[id][2 * axis]].value()) {
+                            fail("inverted interval of object " + std::to_string(id));
                         }
                     }
                 }
