@@ -164,6 +164,8 @@ int main(int argc, char** argv) {
     context.bench = sibling(self, "kolize-bench");
     context.bench2d = sibling(self, "kolize-bench-2d");
     context.demo = sibling(self, "kolize-demo");
+    // The fuzzer is built with the tests: build/tests/ beside build/demos/.
+    context.fuzz = sibling(self.parent_path().parent_path() / "tests", "kolize-fuzz");
     context.thesisTables = fs::path(KOLIZE_SOURCE_DIR) / "assets/thesis/tables.csv";
     if (doubleDemo.empty()) {
         context.doubleDemoNote = "no --double-demo given";
@@ -201,11 +203,12 @@ int main(int argc, char** argv) {
         "tables 2.3-2.7, scaling, error against run time (sweeps), the store-only lower bound, "
         "2D against Box2D, then the Bullet worlds from kolize-demo: pair output live and "
         "replayed, rays, determinism, dynamics accuracy against time, numerical stability; then "
-        "the narrowphase (mesh against mesh) against FCL and GImpact.\n");
+        "the narrowphase (mesh against mesh) against FCL and GImpact; the differential "
+        "fuzzer's table.\n");
 
     using Section = void (*)(Context&);
     for (Section section : {thesisSection, scalingSection, sweepSection, lowerBoundSection,
-                            box2dSection, demoSections, narrowSection}) {
+                            box2dSection, demoSections, narrowSection, fuzzSection}) {
         section(context);
     }
 

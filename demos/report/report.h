@@ -14,6 +14,7 @@ struct Context {
     fs::path data;  ///< reports/data/
     std::string terminal = "pngcairo";
     fs::path bench, bench2d, demo;  ///< sibling binaries (empty: not found)
+    fs::path fuzz;                  ///< build/tests/kolize-fuzz (empty: not built)
     fs::path doubleDemo;            ///< --double-demo (empty: not given or not found)
     std::string doubleDemoNote;     ///< why the double column is missing, if it is
     fs::path thesisTables;          ///< assets/thesis/tables.csv
@@ -55,5 +56,6 @@ void lowerBoundSection(Context& context);
 void box2dSection(Context& context);
 void demoSections(Context& context);
 void narrowSection(Context& context);
+void fuzzSection(Context& context);
 
 }  // namespace report
