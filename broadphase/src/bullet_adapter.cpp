@@ -651,7 +651,11 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, bool full, std::si
             lookAtDuePairs(moved.slot, dispatcher, everyFrame);
         }
     }
-    if (everyFrame) {
+    endSearch(dispatcher, full, candidates);
+}
+
+void BroadphaseAdapter::endSearch(btDispatcher* dispatcher, bool full, std::size_t candidates) {
+    if (settings_.filters == FilterEvaluation::EveryFrame) {
         // The pairs nobody looked at: their status stands, their filters are asked again.
         for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
             const PairStore::Pair& pair = pairs_[at];
@@ -680,7 +684,6 @@ void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, bool full, std::si
 }
 
 void BroadphaseAdapter::finishTrackedPairs(btDispatcher* dispatcher) {
-    const bool everyFrame = settings_.filters == FilterEvaluation::EveryFrame;
     testedThisFrame_ = 0;
     // The store holds exactly the overlapping pairs: a changed pair is either overlapping
     // (into the cache, filters permitting) or erased. No erasing until the end (callbacks
@@ -709,30 +712,7 @@ void BroadphaseAdapter::finishTrackedPairs(btDispatcher* dispatcher) {
         }
     }
     coreChanges_.clear();
-    if (everyFrame) {
-        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
-            const PairStore::Pair& pair = pairs_[at];
-            if (pair.status != PairStore::Status::Apart &&
-                state_[pair.object[0]] == SlotState::Live &&
-                state_[pair.object[1]] == SlotState::Live) {
-                applyFilter(at, true, dispatcher);
-            }
-        }
-    }
-    --deferErasures_;
-    erasePairs(doomed_);
-    for (const Moved& moved : processing_) {
-        frameKind_[moved.slot] = 0;
-    }
-    searching_ = false;
-    if (deferErasures_ == 0) {
-        releasePendingSlots();
-    }
-    ++counters_.incrementalSearches;
-    ++counters_.frames;
-    counters_.candidatesLastFrame = 0;
-    counters_.pairsTestedLastFrame = testedThisFrame_;
-    counters_.objectsLookedAtLastFrame = processing_.size();
+    endSearch(dispatcher, false, 0);
 }
 
 SceneMeasure BroadphaseAdapter::takeMeasure() {

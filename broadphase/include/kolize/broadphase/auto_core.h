@@ -195,39 +195,31 @@ class AutoCore {
         return text;
     }
 
-    template <class F>
-    void dispatch(F&& f) {
-        switch (kind_) {
+    /// Calls f with the active core (const or not, as `self` is).
+    template <class Self, class F>
+    static void dispatchOn(Self& self, F&& f) {
+        switch (self.kind_) {
             case Kind::Grid:
-                f(grid_);
+                f(self.grid_);
                 return;
             case Kind::SpatialHash:
-                f(hash_);
+                f(self.hash_);
                 return;
             case Kind::SegmentTrees:
-                f(trees_);
+                f(self.trees_);
                 return;
             case Kind::Sweep:
-                f(sweep_);
+                f(self.sweep_);
                 return;
         }
     }
     template <class F>
+    void dispatch(F&& f) {
+        dispatchOn(*this, f);
+    }
+    template <class F>
     void dispatch(F&& f) const {
-        switch (kind_) {
-            case Kind::Grid:
-                f(grid_);
-                return;
-            case Kind::SpatialHash:
-                f(hash_);
-                return;
-            case Kind::SegmentTrees:
-                f(trees_);
-                return;
-            case Kind::Sweep:
-                f(sweep_);
-                return;
-        }
+        dispatchOn(*this, f);
     }
 
     Settings settings_;

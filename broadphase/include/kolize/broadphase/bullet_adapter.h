@@ -214,6 +214,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
         pairs_[pairs_.findOrInsert(a, b, inserted)].stamp = stamp_;
     }
     void finishPairs(btDispatcher* dispatcher, bool full, std::size_t candidates);
+    /// The end of every pair search: filters asked again (EveryFrame; the tested stamp
+    /// skips pairs already looked at), erasures, released slots, counters.
+    void endSearch(btDispatcher* dispatcher, bool full, std::size_t candidates);
 
     /// For a core that tracks overlaps itself (kTracksOverlaps, "sweep"): exact boxes in
     /// the core (no fat boxes, no certificates, the store holds exactly the overlapping
