@@ -59,6 +59,8 @@ const char* kUsage =
     "  --record FILE             record the first scene's broadphase calls (an untimed run of\n"
     "                            the first broadphase) as a pair stream\n"
     "  --replay FILE             replay a pair stream into the broadphases instead\n"
+    "  --replay-rounds R         replays interleave the broadphases in R rounds; each one's\n"
+    "                            time is the median of its rounds (default 3)\n"
     "  --csv FILE, --json FILE   also write one record per run\n"
     "  --list-scenes             print the scenes as CSV and exit\n"
     "  --help                    this text\n"
@@ -77,6 +79,7 @@ struct Options {
     int frames = 200;
     int referenceSubsteps = 0;
     double fatMargin = -1;  ///< < 0: the broadphases' default
+    int replayRounds = 3;
     bool replayCheck = false;
     bool determinism = false;
     std::string record, replay, csv, json;
@@ -184,6 +187,8 @@ Options parse(int argc, char** argv) {
             options.scene.objects = int(wholeNumber(flag, value, 1, 10000000));
         } else if (flag == "--frames") {
             options.frames = int(wholeNumber(flag, value, 1, 1000000));
+        } else if (flag == "--replay-rounds") {
+            options.replayRounds = int(wholeNumber(flag, value, 1, 100));
         } else if (flag == "--seed") {
             options.scene.seed = std::uint32_t(wholeNumber(flag, value, 0, 4294967295L));
         } else if (flag == "--motion") {
@@ -517,6 +522,9 @@ Record ordered(const Record& record) {
                                   "init_ms",
                                   "step_ms",
                                   "broadphase_ms",
+                                  "rest_ms",
+                                  "rest_frames",
+                                  "rounds",
                                   "ray_ms",
                                   "pairs",
                                   "true_pairs",
@@ -554,6 +562,11 @@ void printTable(const std::string& title, const std::vector<Record>& rows,
                 const kolize::SceneNeeds& needs, bool drift, bool identical) {
     std::printf("\n%s\n", title.c_str());
     std::string header = "| broadphase    | init ms  | step ms  | bp ms    |";
+    const bool rest = std::any_of(rows.begin(), rows.end(),
+                                  [](const Record& row) { return !row["rest_ms"].empty(); });
+    if (rest) {
+        header += " rest ms  |";
+    }
     if (needs.rays) {
         header += " ray ms   |";
     }
@@ -587,6 +600,9 @@ void printTable(const std::string& title, const std::vector<Record>& rows,
         cell("init_ms", 8);
         cell("step_ms", 8);
         cell("broadphase_ms", 8);
+        if (rest) {
+            cell("rest_ms", 8);
+        }
         if (needs.rays) {
             cell("ray_ms", 8);
         }
@@ -644,16 +660,45 @@ std::vector<Record> replayRecords(const kolize::PairStream& stream, const Option
     if (std::find(names.begin(), names.end(), "store-only") == names.end()) {
         names.push_back("store-only");
     }
-    for (const std::string& name : names) {
+    // Rounds interleave the contenders (the machine is shared): each round replays every
+    // broadphase once, and a broadphase's time is the median of its rounds' medians.
+    const std::size_t rounds = std::size_t(std::max(1, options.replayRounds));
+    std::vector<std::vector<double>> frameSeconds(names.size()), restSeconds(names.size());
+    std::vector<kolize::ReplayResult> firstRound(names.size());
+    std::vector<std::string> errors(names.size());
+    for (std::size_t round = 0; round < rounds; ++round) {
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            if (!errors[i].empty()) {
+                continue;
+            }
+            try {
+                kolize::ReplayResult result = kolize::replay(stream, names[i], settings);
+                frameSeconds[i].push_back(result.medianFrameSeconds());
+                restSeconds[i].push_back(result.medianRestingSeconds());
+                if (round == 0) {
+                    firstRound[i] = std::move(result);
+                }
+            } catch (const std::exception& error) {
+                errors[i] = error.what();
+            }
+            progress("replay " + sceneName + ", " + names[i], int(round + 1), int(rounds));
+        }
+    }
+    for (std::size_t i = 0; i < names.size(); ++i) {
         Record r;
         r.text("scene", sceneName);
-        r.text("broadphase", name);
+        r.text("broadphase", names[i]);
         r.text("mode", "replay");
         r.text("precision", sizeof(btScalar) == 8 ? "double" : "float");
         r.count("frames", static_cast<long long>(stream.frames()));
-        try {
-            const kolize::ReplayResult result = kolize::replay(stream, name, settings);
-            r.number("broadphase_ms", 1000 * result.medianFrameSeconds(), 4);
+        if (errors[i].empty()) {
+            const kolize::ReplayResult& result = firstRound[i];
+            r.number("broadphase_ms", 1000 * kolize::median(frameSeconds[i]), 4);
+            if (result.restingFrames() > 0) {
+                r.number("rest_ms", 1000 * kolize::median(restSeconds[i]), 4);
+            }
+            r.count("rest_frames", static_cast<long long>(result.restingFrames()));
+            r.count("rounds", static_cast<long long>(rounds));
             const kolize::ReplayFrame last =
                 result.frames.empty() ? kolize::ReplayFrame{} : result.frames.back();
             r.count("pairs", static_cast<long long>(last.reportedPairs));
@@ -666,10 +711,9 @@ std::vector<Record> replayRecords(const kolize::PairStream& stream, const Option
             }
             r.count("missing_frames", missingFrames);
             r.text("status", "ok");
-        } catch (const std::exception& error) {
-            r.text("status", std::string("error: ") + error.what());
+        } else {
+            r.text("status", "error: " + errors[i]);
         }
-        progress("replay " + sceneName + ", " + name, 1, 1);
         rows.push_back(ordered(r));
     }
     return rows;

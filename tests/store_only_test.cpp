@@ -7,6 +7,7 @@
 #include <btBulletCollisionCommon.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <vector>
@@ -133,6 +134,51 @@ TEST(StoreOnly, FactoryAndReplayKnowIt) {
     EXPECT_EQ(result.frames[0].reportedPairs, 0u);
     EXPECT_EQ(result.totalMissing(), 2u);
     EXPECT_EQ(result.totalExtra(), 0u);
+}
+
+TEST(StoreOnly, ReplayCountsTheFramesAtRest) {
+    // Frame 0 creates two boxes; frame 1 repeats both boxes (at rest, as Bullet's updateAabbs
+    // sends for sleeping bodies); frame 2 moves one by a float ulp; frame 3 repeats again;
+    // frame 4 destroys one.
+    PairStream stream;
+    StreamEvent create;
+    create.op = StreamEvent::Op::Create;
+    create.group = 1;
+    create.mask = -1;
+    create.aabbMax[0] = create.aabbMax[1] = create.aabbMax[2] = 1;
+    stream.events.push_back(create);
+    create.object = 1;
+    stream.events.push_back(create);
+    stream.events.push_back(StreamEvent{});
+    StreamEvent same = create;
+    same.op = StreamEvent::Op::SetAabb;
+    for (std::uint32_t object : {0u, 1u}) {
+        same.object = object;
+        stream.events.push_back(same);
+    }
+    stream.events.push_back(StreamEvent{});
+    StreamEvent moved = same;
+    moved.aabbMax[1] = double(std::nextafter(1.0f, 2.0f));
+    stream.events.push_back(moved);
+    stream.events.push_back(StreamEvent{});
+    stream.events.push_back(moved);
+    stream.events.push_back(StreamEvent{});
+    StreamEvent destroy;
+    destroy.op = StreamEvent::Op::Destroy;
+    destroy.object = 0;
+    stream.events.push_back(destroy);
+    stream.events.push_back(StreamEvent{});
+
+    const ReplayResult result = replay(stream, "sweep");
+    ASSERT_EQ(result.frames.size(), 5u);
+    const std::size_t expected[] = {2, 0, 1, 0, 1};
+    for (std::size_t frame = 0; frame < 5; ++frame) {
+        EXPECT_EQ(result.frames[frame].changedProxies, expected[frame]) << "frame " << frame;
+    }
+    EXPECT_EQ(result.restingFrames(), 2u);
+    EXPECT_GT(result.medianRestingSeconds(), 0.0);
+    EXPECT_EQ(result.frames[3].truePairs, 1u);
+    EXPECT_EQ(result.totalMissing(), 0u);
 }
 
 }  // namespace

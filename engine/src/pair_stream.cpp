@@ -7,6 +7,7 @@
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -255,6 +256,58 @@ double ReplayResult::medianFrameSeconds() const {
     return median(times);
 }
 
+std::size_t ReplayResult::restingFrames() const {
+    std::size_t count = 0;
+    for (const ReplayFrame& frame : frames) {
+        count += frame.changedProxies == 0 ? 1 : 0;
+    }
+    return count;
+}
+
+double ReplayResult::medianRestingSeconds() const {
+    std::vector<double> times;
+    for (const ReplayFrame& frame : frames) {
+        if (frame.changedProxies == 0) {
+            times.push_back(frame.updateSeconds + frame.pairSeconds);
+        }
+    }
+    return times.empty() ? 0.0 : median(times);
+}
+
+namespace {
+
+/// Per frame, the proxies created, destroyed or given a box that differs from their last one
+/// (counted apart from the timed replay).
+std::vector<std::size_t> changedProxiesPerFrame(const PairStream& stream) {
+    std::vector<std::size_t> changed;
+    std::vector<std::array<double, 6>> last;
+    std::size_t count = 0;
+    for (const StreamEvent& event : stream.events) {
+        const std::array<double, 6> box = {event.aabbMin[0], event.aabbMin[1], event.aabbMin[2],
+                                           event.aabbMax[0], event.aabbMax[1], event.aabbMax[2]};
+        switch (event.op) {
+            case StreamEvent::Op::Create:
+                last.push_back(box);
+                ++count;
+                break;
+            case StreamEvent::Op::Destroy:
+                ++count;
+                break;
+            case StreamEvent::Op::SetAabb:
+                count += last[event.object] == box ? 0 : 1;
+                last[event.object] = box;
+                break;
+            case StreamEvent::Op::EndFrame:
+                changed.push_back(count);
+                count = 0;
+                break;
+        }
+    }
+    return changed;
+}
+
+}  // namespace
+
 ReplayResult replay(const PairStream& stream, std::string_view name,
                     const BroadphaseSettings& settings) {
     std::unique_ptr<btBroadphaseInterface> broadphase = makeMeasuredBroadphase(name, settings);
@@ -265,6 +318,7 @@ ReplayResult replay(const PairStream& stream, std::string_view name,
     auto toVector = [](const double* v) {
         return btVector3(btScalar(v[0]), btScalar(v[1]), btScalar(v[2]));
     };
+    const std::vector<std::size_t> changed = changedProxiesPerFrame(stream);
     ReplayFrame frame;
     Clock::time_point start = Clock::now();
     for (const StreamEvent& event : stream.events) {
@@ -307,6 +361,7 @@ ReplayResult replay(const PairStream& stream, std::string_view name,
                 frame.reportedPairs = reported.size();
                 frame.missing = difference.missing.size();
                 frame.extra = difference.extra.size();
+                frame.changedProxies = changed[result.frames.size()];
                 result.frames.push_back(frame);
                 frame = ReplayFrame{};
                 start = Clock::now();

@@ -96,6 +96,9 @@ struct ReplayFrame {
     std::size_t reportedPairs = 0;
     std::size_t missing = 0;  ///< false negatives
     std::size_t extra = 0;    ///< false positives
+    /// Proxies created, destroyed or given a different box in the frame (0: a world at rest,
+    /// every setAabb repeating the box it had).
+    std::size_t changedProxies = 0;
 };
 
 struct ReplayResult {
@@ -105,6 +108,10 @@ struct ReplayResult {
     std::size_t totalExtra() const;
     /// Median over frames of updateSeconds + pairSeconds.
     double medianFrameSeconds() const;
+    /// Frames in which no proxy changed (changedProxies == 0): a world at rest.
+    std::size_t restingFrames() const;
+    /// Median of updateSeconds + pairSeconds over the resting frames; 0 if there are none.
+    double medianRestingSeconds() const;
 };
 
 /// Replays `stream` into makeMeasuredBroadphase(name, settings) (any broadphase name or
