@@ -8,7 +8,7 @@
 #   scripts/ccd-soak.sh [QUERIES] [SEED] [DATA_DIR]
 #
 # SEED defaults to the current time (printed, so a run can be repeated). Runs in chunks of
-# 100 000 queries, each under the shared CPU lock (/tmp/kolize-cpu.lock), so other jobs can
+# 100 000 queries, each under the shared CPU lock (/tmp/kolize-cpu.lock, or KOLIZE_CPU_LOCK), so other jobs can
 # interleave. Prints every disagreement with its seed and query index (rerun one with
 # `kolize-ccd-soak --seed S --first I --queries 1`), writes the chunks' tables to
 # $KOLIZE_BUILD_DIR/ccd-soak/ (default build/ccd-soak/) and exits 1 if anything disagreed.
@@ -19,7 +19,7 @@ build="${KOLIZE_BUILD_DIR:-$repo/build}"
 queries="${1:-1000000}"
 seed="${2:-$(date +%s)}"
 data="${3:-}"
-lock=/tmp/kolize-cpu.lock
+lock="${KOLIZE_CPU_LOCK:-/tmp/kolize-cpu.lock}"  # shared CPU lock; another path runs beside it
 chunk=100000
 out="$build/ccd-soak"
 mkdir -p "$out"

@@ -15,7 +15,7 @@ if [ ! -x "$fuzz" ]; then
     echo "soak: $fuzz is missing; build first (scripts/test.sh, or BUILD_DIR=... scripts/test.sh)" >&2
     exit 2
 fi
-names="grid spatial-tree spatial-hash segment-trees range-tree sweep brute-force"
+names="grid spatial-tree spatial-hash segment-trees range-tree sweep auto brute-force"
 echo "| broadphase | filters | operations | searches | queries | mismatches | crashes |"
 echo "|---|---|--:|--:|--:|--:|--:|"
 status=0
