@@ -301,7 +301,7 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
-        if (measuring_) {
+        if (sampleMotion_) {
             noteMotion(boxes_[slot], box);
         }
         if (coreTracksOverlaps_) {
@@ -464,6 +464,7 @@ bool BroadphaseAdapter::beginPairs() {
         ++counters_.idleFrames;
     }
     ++measuredFrames_;
+    measuredMotionFrames_ += sampleMotion_ ? 1 : 0;
     // The core's all-pairs search pays when many objects moved (and on the first frame).
     if (forceFullSearch_) {
         forceFullSearch_ = false;
@@ -678,6 +679,7 @@ void BroadphaseAdapter::endSearch(btDispatcher* dispatcher, bool full, std::size
     counters_.incrementalSearches += full ? 0 : 1;
     counters_.fullSearches += full ? 1 : 0;
     ++counters_.frames;
+    sampleMotion_ = measuring_ && counters_.frames % kMotionSampleEvery == 1;
     counters_.candidatesLastFrame = candidates;
     counters_.pairsTestedLastFrame = testedThisFrame_;
     counters_.objectsLookedAtLastFrame = processing_.size();
@@ -720,12 +722,12 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     out.objects = liveCount_ - parkedCount_;
     const double frames = std::max<double>(1, double(measuredFrames_));
     out.frames = double(measuredFrames_);
-    out.movedPerFrame = measuredChanges_ / frames;
+    out.movedPerFrame = measuredChanges_ / std::max<double>(1, double(measuredMotionFrames_));
     out.relativeMotion = measuredChanges_ > 0 ? measuredMotion_ / measuredChanges_ : 0;
     out.raysPerFrame = measuredRays_ / frames;
     out.boxQueriesPerFrame = measuredQueries_ / frames;
     measuredChanges_ = measuredMotion_ = measuredRays_ = measuredQueries_ = 0;
-    measuredFrames_ = 0;
+    measuredFrames_ = measuredMotionFrames_ = 0;
     // Sizes and clustering from a sample of at most 1024 live boxes (planes and other
     // boxes over 1e6 m left out).
     std::vector<double> sizes;

@@ -364,10 +364,14 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     void finishCoreSwitch(bool tracking);
 
   private:
+    /// Motion is sampled in one frame of every kMotionSampleEvery (the frame after a search
+    /// whose number is 1 modulo it): its per-setAabb cost stays out of the other frames.
+    static constexpr std::size_t kMotionSampleEvery = 8;
     bool measuring_ = false;
+    bool sampleMotion_ = false;  ///< this frame's setAabb calls feed the motion measure
     bool forceFullSearch_ = false;
     double measuredChanges_ = 0, measuredMotion_ = 0, measuredRays_ = 0, measuredQueries_ = 0;
-    std::size_t measuredFrames_ = 0;
+    std::size_t measuredFrames_ = 0, measuredMotionFrames_ = 0;
 };
 
 /// A btBroadphaseInterface over a kolize core. `Core` provides insert / update / remove,
