@@ -727,5 +727,45 @@ TEST(Auto, SwitchesItsCoreWithoutTouchingPairsThatPersist) {
     EXPECT_GE(cores.size(), 2u);
 }
 
+// The first evaluation (after two searches) switches at once, so short runs do not spend
+// their first 32 frames on the starting core; sizes spread over orders of magnitude take the
+// segment trees even in slow motion (mixed-sizes: sweep was 4x slower there).
+TEST(Auto, FirstChoiceIsImmediateAndSpreadSizesTakeTheSegmentTrees) {
+    for (const bool spread : {false, true}) {
+        SCOPED_TRACE(spread ? "sizes 0.01 .. 100" : "equal sizes");
+        auto broadphase = makeBroadphase("auto");
+        auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+        std::mt19937 random(9);
+        std::uniform_real_distribution<double> jitter(-1e-3, 1e-3);
+        std::vector<btBroadphaseProxy*> proxies;
+        BoxMap boxes;
+        static char client;
+        for (int i = 0; i < 400; ++i) {
+            const btScalar size = btScalar(spread ? std::pow(10.0, -2 + i % 5) : 1.0);
+            const btVector3 lo(btScalar(3 * (i % 20)), btScalar(3 * (i / 20)), 0);
+            ProxyBox box{nullptr, lo, lo + btVector3(size, size, size)};
+            box.proxy =
+                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+            boxes[box.proxy] = box;
+        }
+        for (int frame = 0; frame < 4; ++frame) {
+            for (btBroadphaseProxy* proxy : proxies) {
+                ProxyBox& box = boxes[proxy];
+                const btVector3 step(btScalar(jitter(random)), btScalar(jitter(random)), 0);
+                box.aabbMin += step;
+                box.aabbMax += step;
+                broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+            }
+            const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+        }
+        const std::string description = adapter.coreDescription();
+        EXPECT_EQ(description.rfind(spread ? "auto: segment-trees" : "auto: sweep", 0), 0u)
+            << description;
+        adapter.validate();
+    }
+}
+
 }  // namespace
 }  // namespace kolize

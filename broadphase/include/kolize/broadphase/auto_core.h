@@ -8,16 +8,22 @@
 /// current boxes without touching the pair cache (no pair lost, no cached algorithm freed).
 ///
 /// The rules (measured with kolize-demo over the scene registry, see README):
+/// - sizes spread over more than 30x (90th over 10th percentile): segment-trees, whose cost
+///   does not depend on one cell size or on endpoints of small boxes passing large ones
+///   (mixed-sizes, replayed: segment-trees 0.47x of sap-noray, sweep 1.8x, spatial-hash
+///   3.7x);
 /// - many rays (at least max(16, N/64) per frame): spatial-hash, whose ray walk visits few
 ///   cells and no empty ones (sweep tests every object per ray; measured on mixed-rays and
 ///   bench-raycast: spatial-hash's rays 1.08 and 0.62 ms, grid's 1.08 and 2.04, sweep's
 ///   3.09 and 3.48);
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
 ///   most Bullet worlds, resting or settling): sweep;
-/// - faster motion, sizes spread over more than 30x or objects clustered: segment-trees;
+/// - faster motion, objects clustered: segment-trees;
 /// - faster motion otherwise: grid.
-/// A choice must win two evaluations in a row (every 32 frames) and stands at least 128
-/// frames, so a scene on a threshold does not flip back and forth.
+/// The first evaluation (after two pair searches) switches at once: the starting core
+/// (grid) was nobody's choice. After that a choice must win two evaluations in a row
+/// (every 32 frames) and stands at least 128 frames, so a scene on a threshold does not
+/// flip back and forth.
 
 #include <kolize/broadphase/aabb.h>
 #include <kolize/broadphase/cell_grid.h>
@@ -93,7 +99,7 @@ class AutoCore {
             reason_ = ruleReason_;
             return kind_;
         }
-        if (wanted != pending_) {
+        if (wanted != pending_ && switches_ > 0) {
             pending_ = wanted;  // must win once more
             return kind_;
         }
@@ -167,6 +173,11 @@ class AutoCore {
 
     Kind rule(const SceneMeasure& m) {
         const double n = double(m.objects);
+        if (m.sizeSpread > 30) {
+            ruleReason_ = "sizes spread " + shortNumber(m.sizeSpread) +
+                          "x: segment trees do not depend on one cell size";
+            return Kind::SegmentTrees;
+        }
         if (m.raysPerFrame >= std::max(16.0, n / 64)) {
             ruleReason_ = std::to_string(int(m.raysPerFrame)) +
                           " rays per frame: the sparse cells walk rays through few cells";
@@ -178,9 +189,8 @@ class AutoCore {
                           " of their size): sorted endpoints move few places";
             return Kind::Sweep;
         }
-        if (m.sizeSpread > 30 || m.clustering > 8) {
-            ruleReason_ = "fast motion with sizes spread " + shortNumber(m.sizeSpread) +
-                          "x and clustering " + shortNumber(m.clustering) +
+        if (m.clustering > 8) {
+            ruleReason_ = "fast motion with clustering " + shortNumber(m.clustering) +
                           ": segment trees do not depend on one cell size";
             return Kind::SegmentTrees;
         }
