@@ -767,5 +767,26 @@ TEST(Auto, FirstChoiceIsImmediateAndSpreadSizesTakeTheSegmentTrees) {
     }
 }
 
+// Found by the fuzzer (seed 1, shrunk): "auto" switched to sweep after two searches of an
+// empty world; resetPool then restarted its core on the grid while the adapter still took it
+// for a core that tracks overlaps, and the next pair of overlapping proxies was never found.
+TEST(Auto, ResetPoolAfterASwitchToSweepStillFindsPairs) {
+    auto broadphase = makeBroadphase("auto");
+    auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+    for (int i = 0; i < 3; ++i) {
+        broadphase->calculateOverlappingPairs(nullptr);
+    }
+    ASSERT_EQ(adapter.coreDescription().rfind("auto: sweep", 0), 0u) << adapter.coreDescription();
+    broadphase->resetPool(nullptr);
+    static char client[2];
+    broadphase->createProxy(btVector3(-47.5f, -84.3f, -53.7f), btVector3(61.2f, 107.8f, 83.7f), 0,
+                            &client[0], 4, -1, nullptr);
+    broadphase->createProxy(btVector3(0.17f, 11.5f, -10.9f), btVector3(2.33f, 13.0f, -10.3f), 0,
+                            &client[1], 2, -1, nullptr);
+    broadphase->calculateOverlappingPairs(nullptr);
+    EXPECT_EQ(broadphase->getOverlappingPairCache()->getNumOverlappingPairs(), 1);
+    adapter.validate();
+}
+
 }  // namespace
 }  // namespace kolize

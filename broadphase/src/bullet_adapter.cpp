@@ -423,9 +423,13 @@ Ray<3, btScalar> BroadphaseAdapter::toRay(const btVector3& rayFrom,
     return ray;
 }
 
-std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery(bool ray) {
+std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery(bool ray,
+                                                                        double rayLength) {
     if (measuring_) {
         (ray ? measuredRays_ : measuredQueries_) += 1;
+        if (ray && std::isfinite(rayLength)) {
+            measuredRayLength_ += std::min(std::max(rayLength, 0.0), 1e12);
+        }
     }
     // A deque: a nested query's new level does not move the lists of the levels below.
     if (queryDepth_ == queryScratch_.size()) {
@@ -725,8 +729,10 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     out.movedPerFrame = measuredChanges_ / std::max<double>(1, double(measuredMotionFrames_));
     out.relativeMotion = measuredChanges_ > 0 ? measuredMotion_ / measuredChanges_ : 0;
     out.raysPerFrame = measuredRays_ / frames;
+    const double meanRayLength = measuredRays_ > 0 ? measuredRayLength_ / measuredRays_ : 0;
     out.boxQueriesPerFrame = measuredQueries_ / frames;
     measuredChanges_ = measuredMotion_ = measuredRays_ = measuredQueries_ = 0;
+    measuredRayLength_ = 0;
     measuredFrames_ = measuredMotionFrames_ = 0;
     // Sizes and clustering from a sample of at most 1024 live boxes (planes and other
     // boxes over 1e6 m left out).
@@ -756,6 +762,7 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     std::sort(sorted.begin(), sorted.end());
     const double p10 = sorted[sorted.size() / 10], p90 = sorted[sorted.size() * 9 / 10];
     const double median = sorted[sorted.size() / 2];
+    out.rayLength = median > 0 ? meanRayLength / median : (meanRayLength > 0 ? 1e9 : 0);
     out.sizeSpread = p10 > 0 ? p90 / p10 : (p90 > 0 ? 1e9 : 1);
     // Clustering: sampled centres per occupied coarse cell (4 median sizes), against what
     // the same count spread evenly over the centres' bounds would give.

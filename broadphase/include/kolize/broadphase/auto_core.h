@@ -12,7 +12,8 @@
 ///   does not depend on one cell size or on endpoints of small boxes passing large ones
 ///   (mixed-sizes, replayed: segment-trees 0.47x of sap-noray, sweep 1.8x, spatial-hash
 ///   3.7x);
-/// - many rays (at least max(16, N/64) per frame): spatial-hash, whose ray walk visits few
+/// - many long rays (at least max(16, N/64) per frame, reaching 8 box sizes or more; CCD's
+///   short sweeps do not count): spatial-hash, whose ray walk visits few
 ///   cells and no empty ones (sweep tests every object per ray; measured on mixed-rays and
 ///   bench-raycast: spatial-hash's rays 1.08 and 0.62 ms, grid's 1.08 and 2.04, sweep's
 ///   3.09 and 3.48);
@@ -44,6 +45,7 @@ struct SceneMeasure {
     double sizeSpread = 1;      ///< 90th over 10th percentile of box sizes (sampled)
     double clustering = 1;      ///< objects per occupied coarse cell over the uniform figure
     double raysPerFrame = 0;
+    double rayLength = 0;  ///< mean reach of the rays, in median box sizes (sampled sizes)
     double boxQueriesPerFrame = 0;
 };
 
@@ -166,6 +168,10 @@ class AutoCore {
     }
 
   private:
+    /// Rays shorter than this many median box sizes (Bullet's CCD sweeps of one step's
+    /// motion) are cheap in every core and do not decide.
+    static constexpr double kLongRay = 8;
+
     static SegmentTreeSettings noKeptSet(SegmentTreeSettings settings) {
         settings.incremental = false;  // the adapter keeps the candidate pairs itself
         return settings;
@@ -178,9 +184,10 @@ class AutoCore {
                           "x: segment trees do not depend on one cell size";
             return Kind::SegmentTrees;
         }
-        if (m.raysPerFrame >= std::max(16.0, n / 64)) {
-            ruleReason_ = std::to_string(int(m.raysPerFrame)) +
-                          " rays per frame: the sparse cells walk rays through few cells";
+        if (m.raysPerFrame >= std::max(16.0, n / 64) && m.rayLength >= kLongRay) {
+            ruleReason_ = std::to_string(int(m.raysPerFrame)) + " rays per frame, " +
+                          shortNumber(m.rayLength) +
+                          " box sizes long: the sparse cells walk rays through few cells";
             return Kind::SpatialHash;
         }
         if (m.movedPerFrame < 0.5 || m.relativeMotion < 0.2) {

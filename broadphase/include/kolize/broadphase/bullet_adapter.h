@@ -172,7 +172,8 @@ class BroadphaseAdapter : public btBroadphaseInterface {
 
     /// Scratch for one query: collect the hits into it, then call reportHits. Queries
     /// nest (a callback may query again); each level has its own list.
-    std::vector<QueryHit>& beginQuery(bool ray);
+    /// `rayLength`: a ray's reach (the callback's lambda_max), measured by "auto".
+    std::vector<QueryHit>& beginQuery(bool ray, double rayLength = 0);
     void addHit(std::vector<QueryHit>& hits, ObjectId id) const {
         hits.push_back(QueryHit{id, proxyOf(id)->m_uniqueId});
     }
@@ -370,7 +371,8 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     bool measuring_ = false;
     bool sampleMotion_ = false;  ///< this frame's setAabb calls feed the motion measure
     bool forceFullSearch_ = false;
-    double measuredChanges_ = 0, measuredMotion_ = 0, measuredRays_ = 0, measuredQueries_ = 0;
+    double measuredChanges_ = 0, measuredMotion_ = 0, measuredRays_ = 0, measuredQueries_ = 0,
+           measuredRayLength_ = 0;
     std::size_t measuredFrames_ = 0, measuredMotionFrames_ = 0;
 };
 
@@ -456,7 +458,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
             return;
         }
         const Ray<3, btScalar> ray = toRay(rayFrom, callback, aabbMin, aabbMax);
-        std::vector<QueryHit>& hits = beginQuery(true);
+        std::vector<QueryHit>& hits = beginQuery(true, double(callback.m_lambda_max));
         core_.queryRay(ray, [&](ObjectId id) {
             if (rayHits(boxOf(id), ray)) {
                 addHit(hits, id);
@@ -520,7 +522,10 @@ class CoreBroadphase final : public BroadphaseAdapter {
     void coreInsert(ObjectId id, const Box& box) override { core_.insert(id, box); }
     void coreUpdate(ObjectId id, const Box& box) override { core_.update(id, box); }
     void coreRemove(ObjectId id) override { core_.remove(id); }
-    void coreReset() override { core_ = Core(coreSettings_); }
+    void coreReset() override {
+        core_ = Core(coreSettings_);
+        coreTracksOverlaps_ = tracksNow();  // "auto" starts again on its first core
+    }
     void coreValidate() const override { core_.validate(); }
     std::size_t coreMemoryBytes() const override { return core_.memoryBytes(); }
 
