@@ -583,7 +583,7 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
     for (int i = 0; i < 3; ++i) {
         // Landing and settling; at rest the bodies sit on their persistent points, at most
         // touching, and an exact test finds nothing new.
-        EXPECT_GE(checkedFrames[i], 5) << "level " << i << ": too few frames with contacts";
+        EXPECT_GE(checkedFrames[i], 10) << "level " << i << ": too few frames with contacts";
     }
     double restTop = 0;
     for (int i = 0; i < 3; ++i) {
@@ -662,7 +662,7 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
     for (int b = 0; b < 2; ++b) {
         btRigidBody* box = scene.boxes[b];
         const btTransform& t = box->getWorldTransform();
-        EXPECT_GE(checkedFrames[b], 5) << "box " << b << ": too few frames with contacts";
+        EXPECT_GE(checkedFrames[b], 8) << "box " << b << ": too few frames with contacts";
         EXPECT_GT(lowest[b], 0.47) << "box " << b << " sank";  // no fall-through
         EXPECT_NEAR(t.getOrigin().z(), 0.5, 0.02) << "box " << b;
         EXPECT_LT(box->getLinearVelocity().length(), 0.05) << "box " << b;
@@ -721,6 +721,64 @@ TEST(BulletMeshContacts, ConvexShapesRestOnAMesh) {
     EXPECT_NEAR(crate->getWorldTransform().getOrigin().z(), 0.4, 0.05);
     EXPECT_LT(ball->getLinearVelocity().length(), 0.05);
     EXPECT_LT(crate->getLinearVelocity().length(), 0.05);
+}
+
+/// Compounds keep Bullet's compound algorithm, which hands each child to the pairs above:
+/// a convex child and a mesh child, each 0.05 into a mesh ground.
+TEST(BulletMeshContacts, CompoundChildrenReachTheMeshAlgorithms) {
+    World w;
+    btRigidBody* ground = w.add(boxShape(Vec3(5, 5, 0.5)), at(0, 0, -0.5), 0);
+    auto compound = std::make_shared<btCompoundShape>();
+    auto box = std::make_shared<btBoxShape>(btVector3(0.5, 0.5, 0.5));
+    auto mesh = boxShape(Vec3(0.5, 0.5, 0.5));
+    compound->addChildShape(at(-1, 0, 0), box.get());
+    compound->addChildShape(at(1, 0, 0), mesh.get());
+    w.shapes.push_back(box);
+    w.shapes.push_back(mesh);
+    // Away from the ground's top diagonal: Bullet's per-triangle convex test gives a convex
+    // straddling an internal edge a sideways normal (its internal-edge problem, which the
+    // convex child inherits; bullet_mesh.h).
+    btRigidBody* body = w.add(compound, at(0, 2, 0.45), 1);
+    ContactCollector collector;
+    w.world.contactPairTest(body, ground, collector);
+    bool convexChild = false, meshChild = false;
+    for (const btManifoldPoint& p : collector.points) {
+        EXPECT_NEAR(p.m_normalWorldOnB.z(), 1, 1e-4);  // on the ground, towards the body
+        const btVector3 onGround = p.getPositionWorldOnB();
+        convexChild = convexChild || onGround.x() < -0.4;
+        meshChild = meshChild || onGround.x() > 0.4;
+        if (onGround.x() > 0.4) {
+            EXPECT_NEAR(p.getDistance(), -0.05, 1e-5);  // the exact mesh-mesh depth
+        }
+    }
+    EXPECT_TRUE(convexChild);
+    EXPECT_TRUE(meshChild);
+}
+
+/// Scaled scenery (btScaledBvhTriangleMeshShape) goes through the same algorithm.
+TEST(BulletMeshContacts, ScaledSceneryIsMeshScenery) {
+    World w;
+    btTriangleMesh triangles;
+    triangles.addTriangle(btVector3(-1, -1, 0), btVector3(1, -1, 0), btVector3(1, 1, 0));
+    triangles.addTriangle(btVector3(-1, -1, 0), btVector3(1, 1, 0), btVector3(-1, 1, 0));
+    auto floor = std::make_shared<btBvhTriangleMeshShape>(&triangles, true);
+    w.shapes.push_back(floor);
+    btRigidBody* scenery =
+        w.add(std::make_shared<btScaledBvhTriangleMeshShape>(floor.get(), btVector3(3, 3, 1)),
+              at(0, 0, 0), 0);
+    // Outside the unscaled floor (|x| > 1), inside the scaled one.
+    btRigidBody* body = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(2, 2, 0.48), 1);
+    w.world.performDiscreteCollisionDetection();
+    auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(scenery, body));
+    ASSERT_NE(algorithm, nullptr);
+    EXPECT_EQ(algorithm->lastContacts().size(), 4u);
+    ContactCollector collector;
+    w.world.contactPairTest(body, scenery, collector);
+    ASSERT_FALSE(collector.points.empty());
+    for (const btManifoldPoint& p : collector.points) {
+        EXPECT_NEAR(p.m_normalWorldOnB.z(), 1, 1e-6);
+        EXPECT_NEAR(p.getDistance(), -0.02, 1e-5);
+    }
 }
 
 /// Every body's transform and velocity after `steps` steps of a scene, as raw bytes.

@@ -38,7 +38,9 @@
 ///
 /// Convex shapes against a MeshShape: the mesh's tree is queried with the convex's box, then
 /// Bullet's own convex-triangle algorithms (GJK/EPA per triangle, btConvexTriangleCallback)
-/// make the contacts, as for a btBvhTriangleMeshShape.
+/// make the contacts, as for a btBvhTriangleMeshShape, and with its known weakness: a convex
+/// across an edge between two triangles of one flat face can get a sideways normal from the
+/// triangle it barely overlaps (Bullet's internal-edge contacts; no filter here yet).
 #include "kolize/narrowphase/mesh_model.h"
 #include "kolize/narrowphase/mesh_query.h"
 
