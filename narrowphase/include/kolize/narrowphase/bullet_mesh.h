@@ -1,0 +1,264 @@
+#pragma once
+/// \file
+/// The narrowphase inside Bullet: a mesh shape over a narrowphase MeshModel, the collision
+/// algorithms that give it exact contacts, and their registration on a dispatcher. This is
+/// the narrowphase's only Bullet adapter (header and source): everything below it
+/// (mesh_model.h, mesh_query.h, triangle_test.h) knows nothing of Bullet.
+///
+/// Use:
+/// \code
+///   auto model = kolize::makeMeshModel(kolize::narrowphase::TriangleMesh::fromArrays(
+///       "duck", xyz, vertexCount, indices, indexCount));     // throws MeshError on bad data
+///   kolize::MeshShape shape(model);                          // bodies may share `model`
+///   kolize::registerNarrowphase(&dispatcher);                // once per dispatcher
+/// \endcode
+///
+/// Contacts (mesh against mesh, and mesh against btBvhTriangleMeshShape scenery) come from
+/// the exactly intersecting triangle pairs (mesh_query.h, QueryMode::kContacts): no pair that
+/// does not touch makes a contact, so there are no ghost contacts; separated meshes make
+/// none (there is no contact margin in this version). The pairs are grouped into patches
+/// (pairs whose triangles share a vertex index on either mesh). Per patch, the normal n and
+/// the depth come from a separating-axis test on the patch's own triangles: the candidate
+/// directions are their face normals (A's outward, B's reversed; the 64 with the longest
+/// intersections) and NARROWPHASE.md's `normalize(sum of w (n_A - n_B))` (w the segment's
+/// length, the square root of the overlap area for coplanar pairs); the one along which A's
+/// patch vertices and B's overlap least is n (from A towards B), the overlap is the depth.
+/// For a box resting on a face this is that face's normal and the exact overlap, also when
+/// the box is tilted so that only a corner or an edge goes in (where the weighted sum alone
+/// tilts by the side faces' share). The depth is local (v1): it sees only the touched
+/// triangles.
+/// Up to 4 points per manifold are chosen from the intersection points of every patch: the
+/// deepest, the farthest from it, then the two that maximise the spanned area (Bullet's
+/// sortCachedPoints rule). Each point carries its patch's normal and depth, and the triangle
+/// ids of its pair through setShapeIdentifiersA/B(0, triangle) (scenery: its part and
+/// triangle). The manifold is persistent: Bullet's refreshContactPoints() drops the points
+/// that moved apart, as for its own algorithms. A body at rest is mostly held by these kept
+/// points (the solver leaves it touching or a hair apart, where the exact test finds no
+/// new pair); contactTest/contactPairTest then report nothing until the meshes touch.
+///
+/// Convex shapes against a MeshShape: the mesh's tree is queried with the convex's box, then
+/// Bullet's own convex-triangle algorithms (GJK/EPA per triangle, btConvexTriangleCallback)
+/// make the contacts, as for a btBvhTriangleMeshShape, and with its known weakness: a convex
+/// across an edge between two triangles of one flat face can get a sideways normal from the
+/// triangle it barely overlaps (Bullet's internal-edge contacts; no filter here yet).
+#include "kolize/narrowphase/mesh_model.h"
+#include "kolize/narrowphase/mesh_query.h"
+
+#include <BulletCollision/BroadphaseCollision/btCollisionAlgorithm.h>
+#include <BulletCollision/CollisionDispatch/btActivatingCollisionAlgorithm.h>
+#include <BulletCollision/CollisionDispatch/btCollisionCreateFunc.h>
+#include <BulletCollision/CollisionDispatch/btConvexConcaveCollisionAlgorithm.h>
+#include <BulletCollision/CollisionShapes/btConcaveShape.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+class btCollisionDispatcher;
+class btPersistentManifold;
+
+namespace kolize {
+
+/// Builds the model a MeshShape needs (an OBB tree, leaf size from `leafSize`, default 4).
+/// Bad mesh data is refused by TriangleMesh itself (narrowphase::MeshError naming the mesh
+/// and the element: non-finite vertex, index out of range, no triangles).
+std::shared_ptr<const narrowphase::MeshModel> makeMeshModel(narrowphase::TriangleMesh mesh,
+                                                            int leafSize = 4);
+
+/// Volume integrals of a closed mesh (density 1), in its model frame.
+struct MeshMassProperties {
+    bool closed = false;  ///< every directed edge (i, j) matched by exactly one (j, i)
+    double volume = 0;    ///< > 0 for a closed mesh (winding inverted meshes are flipped)
+    narrowphase::Vec3 centroid = narrowphase::Vec3::Zero();
+    /// Inertia tensor per unit density about the centroid, model axes.
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+};
+
+/// Volume, centroid and inertia of `mesh` (divergence theorem, one tetrahedron per triangle
+/// from the origin). O(triangles log triangles) for the closedness check. For an open mesh
+/// `closed` is false and the other fields hold the integrals of the open surface's cone,
+/// which are meaningless.
+MeshMassProperties meshMassProperties(const narrowphase::TriangleMesh& mesh);
+
+/// A Bullet concave shape (m_shapeType CUSTOM_CONCAVE_SHAPE_TYPE, which Bullet 3.24 also
+/// calls SDF_SHAPE_PROXYTYPE: registerNarrowphase() must be called on every dispatcher that
+/// sees it, else convex pairs take Bullet's SDF path) over a narrowphase MeshModel.
+///
+/// The model (mesh and OBB tree) is shared: many shapes, and many bodies per shape, may use
+/// one. Scaling makes a shape its own scaled model (see setLocalScaling). Margin: 0 by
+/// default; it only widens the broadphase box (contacts stay exact).
+class MeshShape : public btConcaveShape {
+  public:
+    BT_DECLARE_ALIGNED_ALLOCATOR();
+
+    /// Throws std::invalid_argument for a null model or a model whose tree is not an OBB
+    /// tree (the Bullet algorithms query OBB trees only).
+    explicit MeshShape(std::shared_ptr<const narrowphase::MeshModel> model);
+
+    /// The model queries use: the shared model, or this shape's scaled copy.
+    const narrowphase::MeshModel& model() const { return *scaled_; }
+    const std::shared_ptr<const narrowphase::MeshModel>& sharedModel() const { return scaled_; }
+    /// The unscaled model the shape was made from.
+    const std::shared_ptr<const narrowphase::MeshModel>& baseModel() const { return base_; }
+    /// Mass properties of the scaled mesh (computed with the model).
+    const MeshMassProperties& massProperties() const { return mass_; }
+
+    /// Box around the tree's root volume (scaled model) moved by `t`, cut down to the box
+    /// around the moved model-space vertex box (the root OBB of a cube has arbitrary axes),
+    /// widened by the margin, rounded outward to btScalar. O(1).
+    void getAabb(const btTransform& t, btVector3& aabbMin, btVector3& aabbMax) const override;
+    /// Calls `callback` once for every triangle whose box meets [aabbMin, aabbMax] (scaled
+    /// model frame, closed), in the tree's depth-first order, with part 0 and the triangle's
+    /// index in the mesh. O(log n + triangles reported) for a small box.
+    void processAllTriangles(btTriangleCallback* callback, const btVector3& aabbMin,
+                             const btVector3& aabbMax) const override;
+    /// Closed mesh: the diagonal of the inertia tensor of the solid about its centroid,
+    /// mass / volume as density (exact when the model axes are principal axes, as for the
+    /// boxes and symmetric meshes; use massProperties() for the full tensor). Open mesh:
+    /// the inertia of a solid box of the vertices' axis-aligned bounds (contained in the
+    /// root volume).
+    void calculateLocalInertia(btScalar mass, btVector3& inertia) const override;
+    /// Scales the model frame (vertices multiplied per axis). Scaling other than (1, 1, 1)
+    /// builds this shape's own scaled model (O(n log n), not shared); (1, 1, 1) goes back
+    /// to the shared one. Throws std::invalid_argument, naming the mesh and the scale, for
+    /// a zero, negative or non-finite component; the shape is unchanged then.
+    void setLocalScaling(const btVector3& scaling) override;
+    const btVector3& getLocalScaling() const override { return scaling_; }
+    const char* getName() const override { return "KolizeMesh"; }
+
+  private:
+    void adoptModel(std::shared_ptr<const narrowphase::MeshModel> model);
+
+    std::shared_ptr<const narrowphase::MeshModel> base_;
+    std::shared_ptr<const narrowphase::MeshModel> scaled_;
+    MeshMassProperties mass_;
+    btVector3 scaling_{1, 1, 1};
+    narrowphase::Obb root_;                                   ///< the tree's root volume
+    narrowphase::Vec3 boundsLo_ = narrowphase::Vec3::Zero();  ///< the vertices' box
+    narrowphase::Vec3 boundsHi_ = narrowphase::Vec3::Zero();
+};
+
+/// One contact in the world, before it goes to Bullet: on the meshes X (the first) and Y.
+struct MeshContact {
+    narrowphase::Vec3 point = narrowphase::Vec3::Zero();   ///< on the intersection curve
+    narrowphase::Vec3 normal = narrowphase::Vec3::Zero();  ///< unit, from X towards Y
+    double depth = 0;                                      ///< >= 0
+    std::int32_t partX = 0, triangleX = -1, partY = 0, triangleY = -1;
+};
+
+/// MeshShape against MeshShape: the exact mesh query, contacts from its triangle pairs.
+class MeshMeshAlgorithm : public btActivatingCollisionAlgorithm {
+  public:
+    MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                      const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1);
+    ~MeshMeshAlgorithm() override;
+    void processCollision(const btCollisionObjectWrapper* body0,
+                          const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
+                          btManifoldResult* resultOut) override;
+    /// 1 (no time of impact yet: continuous collision is a later stage).
+    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
+                                   const btDispatcherInfo& info,
+                                   btManifoldResult* resultOut) override;
+    void getAllContactManifolds(btManifoldArray& manifolds) override;
+    /// The contacts made by the last processCollision (world frame, X = body0).
+    const std::vector<MeshContact>& lastContacts() const;
+
+    struct CreateFunc : btCollisionAlgorithmCreateFunc {
+        btCollisionAlgorithm* CreateCollisionAlgorithm(
+            btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+            const btCollisionObjectWrapper* body1) override;
+    };
+
+  private:
+    struct State;  // the query and the contacts, off Bullet's fixed-size algorithm pool
+    btPersistentManifold* manifold_ = nullptr;
+    bool ownManifold_ = false;
+    std::unique_ptr<State> state_;
+};
+
+/// A convex shape against a MeshShape (either order): the tree gives the triangles in the
+/// convex's box, Bullet's convex-triangle algorithm the contacts. Never the SDF path.
+class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
+  public:
+    ConvexMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                        const btCollisionObjectWrapper* body0,
+                        const btCollisionObjectWrapper* body1, bool meshFirst);
+    ~ConvexMeshAlgorithm() override;
+    void processCollision(const btCollisionObjectWrapper* body0,
+                          const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
+                          btManifoldResult* resultOut) override;
+    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
+                                   const btDispatcherInfo& info,
+                                   btManifoldResult* resultOut) override;
+    void getAllContactManifolds(btManifoldArray& manifolds) override;
+
+    struct CreateFunc : btCollisionAlgorithmCreateFunc {
+        btCollisionAlgorithm* CreateCollisionAlgorithm(
+            btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+            const btCollisionObjectWrapper* body1) override;
+    };
+    /// Mesh as body0, convex as body1.
+    struct SwappedCreateFunc : btCollisionAlgorithmCreateFunc {
+        btCollisionAlgorithm* CreateCollisionAlgorithm(
+            btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+            const btCollisionObjectWrapper* body1) override;
+    };
+
+  private:
+    btConvexTriangleCallback triangles_;
+    bool meshFirst_;
+};
+
+/// A MeshShape against Bullet's triangle-mesh scenery (btBvhTriangleMeshShape, any order):
+/// the scenery's own tree gives its triangles in the mesh's box; they become a small
+/// narrowphase mesh in world coordinates (vertices welded where exactly equal, rebuilt each
+/// call: O(k log k) for k triangles), queried exactly against the mesh. Contacts as for two
+/// meshes, the scenery's part and triangle index on each point.
+class BvhMeshAlgorithm : public btActivatingCollisionAlgorithm {
+  public:
+    BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                     const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1,
+                     bool meshFirst);
+    ~BvhMeshAlgorithm() override;
+    void processCollision(const btCollisionObjectWrapper* body0,
+                          const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
+                          btManifoldResult* resultOut) override;
+    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
+                                   const btDispatcherInfo& info,
+                                   btManifoldResult* resultOut) override;
+    void getAllContactManifolds(btManifoldArray& manifolds) override;
+    /// The contacts made by the last processCollision (world frame, X = the MeshShape).
+    const std::vector<MeshContact>& lastContacts() const;
+
+    struct CreateFunc : btCollisionAlgorithmCreateFunc {
+        btCollisionAlgorithm* CreateCollisionAlgorithm(
+            btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+            const btCollisionObjectWrapper* body1) override;
+    };
+    /// Scenery as body0, mesh as body1.
+    struct SwappedCreateFunc : btCollisionAlgorithmCreateFunc {
+        btCollisionAlgorithm* CreateCollisionAlgorithm(
+            btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+            const btCollisionObjectWrapper* body1) override;
+    };
+
+  private:
+    struct State;
+    btPersistentManifold* manifold_ = nullptr;
+    bool ownManifold_ = false;
+    bool meshFirst_;
+    std::unique_ptr<State> state_;
+};
+
+/// Registers the algorithms above on `dispatcher`, in both its contact-point
+/// (registerCollisionCreateFunc) and closest-point (registerClosestPointsCreateFunc) tables:
+/// MeshShape against MeshShape, against every convex shape type in both orders, and against
+/// TRIANGLE_MESH_SHAPE_PROXYTYPE and SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE in both orders.
+/// Compounds keep Bullet's compound algorithm, which dispatches their children to these
+/// pairs. The create functions are static: they outlive every dispatcher. Throws
+/// std::invalid_argument for a null dispatcher, and for a configuration whose collision
+/// algorithm pool has elements smaller than these algorithms (Bullet's pool would hand out
+/// too small blocks; btDefaultCollisionConfiguration's are large enough).
+void registerNarrowphase(btCollisionDispatcher* dispatcher);
+
+}  // namespace kolize

@@ -1,0 +1,914 @@
+#include "kolize/narrowphase/bullet_mesh.h"
+
+#include <BulletCollision/CollisionDispatch/btCollisionConfiguration.h>
+#include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <LinearMath/btPoolAllocator.h>
+#include <BulletCollision/CollisionDispatch/btCollisionObject.h>
+#include <BulletCollision/CollisionDispatch/btCollisionObjectWrapper.h>
+#include <BulletCollision/CollisionDispatch/btManifoldResult.h>
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace kolize {
+
+using narrowphase::Index3;
+using narrowphase::MeshModel;
+using narrowphase::ObbNode;
+using narrowphase::ObbTree;
+using narrowphase::PairContact;
+using narrowphase::Pose;
+using narrowphase::QueryMode;
+using narrowphase::QueryResult;
+using narrowphase::QuerySettings;
+using narrowphase::RelativePose;
+using narrowphase::TriangleIntersection;
+using narrowphase::TriangleMesh;
+using narrowphase::Vec3;
+
+namespace {
+
+Vec3 toVec3(const btVector3& v) {
+    return Vec3(double(v.x()), double(v.y()), double(v.z()));
+}
+
+btVector3 toBt(const Vec3& v) {
+    return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z()));
+}
+
+/// btScalar at or below x (at or above for `up`): boxes stay conservative after rounding.
+btScalar roundOutward(double x, bool up) {
+    btScalar r = btScalar(x);
+    if (up && double(r) < x) {
+        r = std::nextafter(r, std::numeric_limits<btScalar>::infinity());
+    } else if (!up && double(r) > x) {
+        r = std::nextafter(r, -std::numeric_limits<btScalar>::infinity());
+    }
+    return r;
+}
+
+/// The rigid pose of a Bullet transform in double. Bullet's float bases are orthonormal
+/// only to about 1e-7; going through a normalised quaternion makes them orthonormal to
+/// double rounding, which the mesh query requires (1e-6), for any build of Bullet.
+Pose toPose(const btTransform& t) {
+    Eigen::Matrix3d basis;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+            basis(r, c) = double(t.getBasis()[r][c]);
+        }
+    }
+    Pose pose;
+    if (basis == Eigen::Matrix3d::Identity()) {
+        pose.rotation = basis;
+    } else {
+        Eigen::Quaterniond q(basis);
+        q.normalize();
+        pose.rotation = q.toRotationMatrix();
+    }
+    pose.translation = toVec3(t.getOrigin());
+    return pose;
+}
+
+bool finitePose(const btTransform& t) {
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+            if (!std::isfinite(double(t.getBasis()[r][c]))) {
+                return false;
+            }
+        }
+        if (!std::isfinite(double(t.getOrigin()[r]))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/// The root OBB's axis-aligned bounds in the model frame (double, from the float box).
+void obbBounds(const narrowphase::Obb& box, Vec3& lo, Vec3& hi) {
+    const Eigen::Vector3d c = box.center.cast<double>();
+    const Eigen::Vector3d h = box.half.cast<double>();
+    const Eigen::Vector3d a0 = box.axis0.cast<double>();
+    const Eigen::Vector3d a1 = box.axis1.cast<double>();
+    const Eigen::Vector3d a2 = box.axis2().cast<double>();
+    const Eigen::Vector3d extent =
+        a0.cwiseAbs() * h.x() + a1.cwiseAbs() * h.y() + a2.cwiseAbs() * h.z();
+    // Double rounding of the sums above: a relative pad far below float resolution.
+    const Eigen::Vector3d pad = (c.cwiseAbs() + extent) * 1e-12;
+    lo = c - extent - pad;
+    hi = c + extent + pad;
+}
+
+// ---------------------------------------------------------------------------------------
+// Contacts from intersecting triangle pairs (bullet_mesh.h's file comment has the rules).
+
+struct Candidate {
+    Vec3 point;
+    int patch;
+    std::int32_t pair;
+};
+
+struct Patch {
+    Vec3 normal = Vec3::Zero();
+    double depth = 0;
+    bool valid = false;
+};
+
+int findRoot(std::vector<int>& parent, int i) {
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/// Unions the pairs that share a vertex index through `vertexOf(pair, k)`.
+template <class VertexOf>
+void unionByVertex(std::size_t pairCount, VertexOf vertexOf, std::vector<int>& parent,
+                   std::vector<std::pair<std::int32_t, int>>& scratch) {
+    scratch.clear();
+    for (std::size_t i = 0; i < pairCount; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            scratch.emplace_back(vertexOf(i, k), int(i));
+        }
+    }
+    std::sort(scratch.begin(), scratch.end());
+    for (std::size_t i = 1; i < scratch.size(); ++i) {
+        if (scratch[i].first == scratch[i - 1].first) {
+            const int x = findRoot(parent, scratch[i].second);
+            const int y = findRoot(parent, scratch[i - 1].second);
+            if (x != y) {
+                parent[std::max(x, y)] = std::min(x, y);  // smallest index: deterministic roots
+            }
+        }
+    }
+}
+
+void uniqueSorted(std::vector<std::int32_t>& values) {
+    std::sort(values.begin(), values.end());
+    values.erase(std::unique(values.begin(), values.end()), values.end());
+}
+
+/// Face normals tried per patch (plus the weighted sum), the heaviest first.
+constexpr std::size_t kMaxNormalCandidates = 64;
+
+/// Scratch of contact building (reused by an algorithm across frames).
+struct ContactScratch {
+    std::vector<int> parent;
+    std::vector<std::pair<std::int32_t, int>> byVertex;
+    std::vector<int> order;
+    std::vector<Patch> patches;
+    std::vector<std::int32_t> verticesA, verticesB;
+    std::vector<Vec3> pointsB;
+    std::vector<std::pair<double, Vec3>> normals;
+    std::vector<Candidate> candidates;
+};
+
+/// Up to 4 contacts (in A's frame, X = A) from the query's pairs. `bInA` is the pose the
+/// query used: B's vertices are classified as bInA.apply(q), and so are they here.
+void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
+                   const RelativePose& bInA, ContactScratch& s, std::vector<MeshContact>& out) {
+    out.clear();
+    const std::vector<PairContact>& pairs = result.contacts;
+    const std::size_t count = pairs.size();
+    if (count == 0) {
+        return;
+    }
+    s.parent.resize(count);
+    std::iota(s.parent.begin(), s.parent.end(), 0);
+    unionByVertex(
+        count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i].pair.a][k]; },
+        s.parent, s.byVertex);
+    unionByVertex(
+        count, [&](std::size_t i, int k) { return meshB.triangles()[pairs[i].pair.b][k]; },
+        s.parent, s.byVertex);
+
+    // Pairs grouped by patch (root), each group in query order.
+    s.order.resize(count);
+    std::iota(s.order.begin(), s.order.end(), 0);
+    std::stable_sort(s.order.begin(), s.order.end(),
+                     [&](int x, int y) { return findRoot(s.parent, x) < findRoot(s.parent, y); });
+    s.patches.assign(count, Patch{});
+    for (std::size_t begin = 0; begin < count;) {
+        const int root = findRoot(s.parent, s.order[begin]);
+        std::size_t end = begin;
+        while (end < count && findRoot(s.parent, s.order[end]) == root) {
+            ++end;
+        }
+        // The patch's vertices (A's, and B's in A's frame) and its candidate normals, each
+        // pointing from A towards B: A's face normals, B's reversed, and the weighted sum.
+        s.verticesA.clear();
+        s.verticesB.clear();
+        s.normals.clear();
+        Vec3 sum = Vec3::Zero();
+        for (std::size_t k = begin; k < end; ++k) {
+            const PairContact& c = pairs[s.order[k]];
+            const Index3& ia = meshA.triangles()[c.pair.a];
+            const Index3& ib = meshB.triangles()[c.pair.b];
+            s.verticesA.insert(s.verticesA.end(), ia.begin(), ia.end());
+            s.verticesB.insert(s.verticesB.end(), ib.begin(), ib.end());
+            const double measure = std::max(c.geometry.measure(), 0.0);
+            const double weight = c.geometry.kind == TriangleIntersection::Kind::kPolygon
+                                      ? std::sqrt(measure)
+                                      : measure;
+            sum += weight * (c.normal_a - c.normal_b);
+            if (c.normal_a.squaredNorm() > 0) {
+                s.normals.push_back({weight, c.normal_a});
+            }
+            if (c.normal_b.squaredNorm() > 0) {
+                s.normals.push_back({weight, -c.normal_b});
+            }
+        }
+        uniqueSorted(s.verticesA);
+        uniqueSorted(s.verticesB);
+        // The heaviest distinct face normals (a deep patch of a fine mesh has thousands).
+        std::sort(s.normals.begin(), s.normals.end(), [](const auto& x, const auto& y) {
+            if (x.first != y.first) {
+                return x.first > y.first;
+            }
+            return std::lexicographical_compare(x.second.data(), x.second.data() + 3,
+                                                y.second.data(), y.second.data() + 3);
+        });
+        s.normals.erase(
+            std::unique(s.normals.begin(), s.normals.end(),
+                        [](const auto& x, const auto& y) { return x.second == y.second; }),
+            s.normals.end());
+        if (s.normals.size() > kMaxNormalCandidates) {
+            s.normals.resize(kMaxNormalCandidates);
+        }
+        if (sum.norm() > 0) {
+            s.normals.push_back({0.0, sum.normalized()});
+        }
+        s.pointsB.clear();
+        for (std::int32_t v : s.verticesB) {
+            s.pointsB.push_back(bInA.apply(meshB.vertices()[v]));
+        }
+        // The candidate along which the patch's pieces overlap least (the separating-axis
+        // idea on the touched triangles): its overlap is the depth.
+        Patch& patch = s.patches[root];
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& candidate : s.normals) {
+            const Vec3& d = candidate.second;
+            double highestA = -std::numeric_limits<double>::infinity();
+            for (std::int32_t v : s.verticesA) {
+                highestA = std::max(highestA, meshA.vertices()[v].dot(d));
+            }
+            double lowestB = std::numeric_limits<double>::infinity();
+            for (const Vec3& q : s.pointsB) {
+                lowestB = std::min(lowestB, q.dot(d));
+            }
+            const double overlap = highestA - lowestB;
+            if (overlap < best) {
+                best = overlap;
+                patch.normal = d;
+            }
+        }
+        patch.valid = std::isfinite(best);
+        patch.depth = patch.valid ? std::max(best, 0.0) : 0.0;
+        begin = end;
+    }
+
+    s.candidates.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+        const int root = findRoot(s.parent, int(i));
+        if (!s.patches[root].valid) {
+            continue;
+        }
+        const TriangleIntersection& g = pairs[i].geometry;
+        for (int k = 0; k < g.count; ++k) {
+            s.candidates.push_back({g.points[k], root, std::int32_t(i)});
+        }
+    }
+    if (s.candidates.empty()) {
+        return;
+    }
+    // Bullet's choice of 4 points: the deepest, the farthest from it, the largest triangle,
+    // the largest quadrilateral (diagonal cross products, as in sortCachedPoints).
+    std::array<int, 4> chosen{};
+    int chosenCount = 0;
+    {
+        int best = 0;
+        for (int i = 1; i < int(s.candidates.size()); ++i) {
+            if (s.patches[s.candidates[i].patch].depth >
+                s.patches[s.candidates[best].patch].depth) {
+                best = i;
+            }
+        }
+        chosen[chosenCount++] = best;
+    }
+    double scale = 0;
+    for (const Candidate& c : s.candidates) {
+        scale = std::max(scale, (c.point - s.candidates[chosen[0]].point).squaredNorm());
+    }
+    // Lengths below 1e-9 of the patch's extent count as zero: no point is chosen twice, and
+    // the areas must be real (steps 2 and 3 compare squared areas).
+    const double tinyLength = 1e-18 * scale;
+    for (int step = 1; step < 4 && scale > 0; ++step) {
+        int best = -1;
+        double bestValue = step == 1 ? tinyLength : tinyLength * scale;
+        for (int i = 0; i < int(s.candidates.size()); ++i) {
+            const Vec3& p = s.candidates[i].point;
+            bool repeated = false;
+            for (int k = 0; k < chosenCount; ++k) {
+                repeated =
+                    repeated || (p - s.candidates[chosen[k]].point).squaredNorm() <= tinyLength;
+            }
+            if (repeated) {
+                continue;
+            }
+            const Vec3& p0 = s.candidates[chosen[0]].point;
+            double value = 0;
+            if (step == 1) {
+                value = (p - p0).squaredNorm();
+            } else if (step == 2) {
+                const Vec3& p1 = s.candidates[chosen[1]].point;
+                value = (p1 - p0).cross(p - p0).squaredNorm();
+            } else {
+                const Vec3& p1 = s.candidates[chosen[1]].point;
+                const Vec3& p2 = s.candidates[chosen[2]].point;
+                value = std::max({(p0 - p1).cross(p2 - p).squaredNorm(),
+                                  (p0 - p2).cross(p1 - p).squaredNorm(),
+                                  (p0 - p).cross(p1 - p2).squaredNorm()});
+            }
+            if (value > bestValue) {
+                bestValue = value;
+                best = i;
+            }
+        }
+        if (best < 0) {
+            break;
+        }
+        chosen[chosenCount++] = best;
+    }
+    for (int k = 0; k < chosenCount; ++k) {
+        const Candidate& c = s.candidates[chosen[k]];
+        const Patch& patch = s.patches[c.patch];
+        MeshContact contact;
+        contact.point = c.point;
+        contact.normal = patch.normal;
+        contact.depth = patch.depth;
+        contact.triangleX = pairs[c.pair].pair.a;
+        contact.triangleY = pairs[c.pair].pair.b;
+        out.push_back(contact);
+    }
+}
+
+/// Moves contacts from A's model frame into the world.
+void toWorld(std::vector<MeshContact>& contacts, const Pose& poseA) {
+    for (MeshContact& c : contacts) {
+        c.point = poseA.rotation * c.point + poseA.translation;
+        c.normal = poseA.rotation * c.normal;
+    }
+}
+
+/// Hands contacts (X, Y) to Bullet, X being body0 of `resultOut` or not.
+void emit(const std::vector<MeshContact>& contacts, bool xIsBody0, btManifoldResult* resultOut) {
+    for (const MeshContact& c : contacts) {
+        // The points straddle the intersection curve by half the depth each: X's deepest
+        // point lies along +n (inside Y), Y's along -n.
+        const Vec3 onX = c.point + c.normal * (0.5 * c.depth);
+        const Vec3 onY = c.point - c.normal * (0.5 * c.depth);
+        if (xIsBody0) {
+            resultOut->setShapeIdentifiersA(c.partX, c.triangleX);
+            resultOut->setShapeIdentifiersB(c.partY, c.triangleY);
+            resultOut->addContactPoint(toBt(-c.normal), toBt(onY), btScalar(-c.depth));
+        } else {
+            resultOut->setShapeIdentifiersA(c.partY, c.triangleY);
+            resultOut->setShapeIdentifiersB(c.partX, c.triangleX);
+            resultOut->addContactPoint(toBt(c.normal), toBt(onX), btScalar(-c.depth));
+        }
+    }
+}
+
+thread_local ContactScratch contactScratch;
+
+QuerySettings contactSettings() {
+    QuerySettings settings;
+    settings.mode = QueryMode::kContacts;
+    settings.use_front = true;
+    return settings;
+}
+
+std::string formatScale(const btVector3& s) {
+    std::ostringstream out;
+    out.precision(9);
+    out << '(' << double(s.x()) << ", " << double(s.y()) << ", " << double(s.z()) << ')';
+    return out.str();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+
+std::shared_ptr<const MeshModel> makeMeshModel(TriangleMesh mesh, int leafSize) {
+    narrowphase::TreeSettings settings;
+    settings.kind = narrowphase::TreeKind::kObb;
+    settings.leaf_size = leafSize;
+    return std::make_shared<const MeshModel>(std::make_shared<const TriangleMesh>(std::move(mesh)),
+                                             settings);
+}
+
+MeshMassProperties meshMassProperties(const TriangleMesh& mesh) {
+    MeshMassProperties out;
+    std::vector<std::pair<std::int32_t, std::int32_t>> edges;
+    edges.reserve(mesh.triangleCount() * 3);
+    for (const Index3& t : mesh.triangles()) {
+        for (int k = 0; k < 3; ++k) {
+            edges.emplace_back(t[k], t[(k + 1) % 3]);
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    out.closed = true;
+    for (std::size_t i = 0; i < edges.size() && out.closed; ++i) {
+        const bool repeated = i + 1 < edges.size() && edges[i + 1] == edges[i];
+        const bool matched = std::binary_search(edges.begin(), edges.end(),
+                                                std::make_pair(edges[i].second, edges[i].first));
+        out.closed = !repeated && matched && edges[i].first != edges[i].second;
+    }
+    // One signed tetrahedron (origin, a, b, c) per triangle: volume det/6, first moment
+    // det (a + b + c) / 24, second moment det/120 (M M^T + s s^T), M = [a b c], s = a + b + c.
+    double volume = 0;
+    Vec3 moment = Vec3::Zero();
+    Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < mesh.triangleCount(); ++i) {
+        const narrowphase::Triangle t = mesh.triangle(i);
+        Eigen::Matrix3d m;
+        m << t[0], t[1], t[2];
+        const double det = m.determinant();
+        const Vec3 sum = t[0] + t[1] + t[2];
+        volume += det / 6;
+        moment += det * sum / 24;
+        second += det / 120 * (m * m.transpose() + sum * sum.transpose());
+    }
+    if (volume < 0) {  // consistently inverted winding
+        volume = -volume;
+        moment = -moment;
+        second = -second;
+    }
+    out.volume = volume;
+    if (volume > 0) {
+        out.centroid = moment / volume;
+        const Eigen::Matrix3d central = second - volume * out.centroid * out.centroid.transpose();
+        out.inertia = central.trace() * Eigen::Matrix3d::Identity() - central;
+    } else {
+        out.closed = false;
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// MeshShape
+
+MeshShape::MeshShape(std::shared_ptr<const MeshModel> model) {
+    m_shapeType = CUSTOM_CONCAVE_SHAPE_TYPE;
+    if (!model) {
+        throw std::invalid_argument("kolize::MeshShape: null mesh model");
+    }
+    if (model->kind() != narrowphase::TreeKind::kObb) {
+        throw std::invalid_argument("kolize::MeshShape: mesh '" + model->mesh().name() +
+                                    "' has a " + narrowphase::treeKindName(model->kind()) +
+                                    " tree; the Bullet algorithms need an OBB tree");
+    }
+    base_ = model;
+    adoptModel(std::move(model));
+}
+
+void MeshShape::adoptModel(std::shared_ptr<const MeshModel> model) {
+    root_ = model->tree<ObbNode>().nodes().front().volume;
+    const std::vector<Vec3>& vertices = model->mesh().vertices();
+    boundsLo_ = boundsHi_ = vertices.front();
+    for (const Vec3& v : vertices) {
+        boundsLo_ = boundsLo_.cwiseMin(v);
+        boundsHi_ = boundsHi_.cwiseMax(v);
+    }
+    mass_ = meshMassProperties(model->mesh());
+    scaled_ = std::move(model);
+}
+
+void MeshShape::getAabb(const btTransform& t, btVector3& aabbMin, btVector3& aabbMax) const {
+    Eigen::Matrix3d basis;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+            basis(r, c) = double(t.getBasis()[r][c]);
+        }
+    }
+    const Vec3 origin = toVec3(t.getOrigin());
+    // The root OBB moved: centre and half extents along the world axes.
+    const Vec3 obbCenter = basis * root_.center.cast<double>() + origin;
+    const Vec3 obbHalf = (basis * root_.axis0.cast<double>()).cwiseAbs() * double(root_.half.x()) +
+                         (basis * root_.axis1.cast<double>()).cwiseAbs() * double(root_.half.y()) +
+                         (basis * root_.axis2().cast<double>()).cwiseAbs() * double(root_.half.z());
+    // The vertex box moved.
+    const Vec3 boxCenter = basis * (0.5 * (boundsLo_ + boundsHi_)) + origin;
+    const Vec3 boxHalf = basis.cwiseAbs() * (0.5 * (boundsHi_ - boundsLo_));
+    // Double rounding of the sums above: a relative pad far below float resolution.
+    const Vec3 pad = (obbCenter.cwiseAbs() + obbHalf + boxCenter.cwiseAbs() + boxHalf) * 1e-12 +
+                     Vec3::Constant(double(getMargin()));
+    const Vec3 lo = (obbCenter - obbHalf).cwiseMax(boxCenter - boxHalf) - pad;
+    const Vec3 hi = (obbCenter + obbHalf).cwiseMin(boxCenter + boxHalf) + pad;
+    aabbMin.setValue(roundOutward(lo.x(), false), roundOutward(lo.y(), false),
+                     roundOutward(lo.z(), false));
+    aabbMax.setValue(roundOutward(hi.x(), true), roundOutward(hi.y(), true),
+                     roundOutward(hi.z(), true));
+}
+
+void MeshShape::processAllTriangles(btTriangleCallback* callback, const btVector3& aabbMin,
+                                    const btVector3& aabbMax) const {
+    const Vec3 lo = toVec3(aabbMin);
+    const Vec3 hi = toVec3(aabbMax);
+    const ObbTree& tree = model().tree<ObbNode>();
+    const std::vector<ObbNode>& nodes = tree.nodes();
+    const std::vector<narrowphase::Vec3>& vertices = model().mesh().vertices();
+    // Depth-first walk: the first child is the next node, the second `link.right()`.
+    std::vector<std::int32_t> stack{0};
+    btVector3 triangle[3];
+    while (!stack.empty()) {
+        const std::int32_t index = stack.back();
+        stack.pop_back();
+        const ObbNode& node = nodes[index];
+        Vec3 nodeLo, nodeHi;
+        obbBounds(node.volume, nodeLo, nodeHi);
+        if ((nodeLo.array() > hi.array()).any() || (lo.array() > nodeHi.array()).any()) {
+            continue;
+        }
+        if (!node.link.isLeaf()) {
+            stack.push_back(node.link.right());
+            stack.push_back(index + 1);
+            continue;
+        }
+        for (int k = 0; k < node.link.count(); ++k) {
+            const std::int32_t slot = node.link.firstSlot() + k;
+            const Index3& t = tree.slotTriangles()[slot];
+            const Vec3& p = vertices[t[0]];
+            const Vec3& q = vertices[t[1]];
+            const Vec3& r = vertices[t[2]];
+            const Vec3 tlo = p.cwiseMin(q).cwiseMin(r);
+            const Vec3 thi = p.cwiseMax(q).cwiseMax(r);
+            if ((tlo.array() > hi.array()).any() || (lo.array() > thi.array()).any()) {
+                continue;
+            }
+            triangle[0] = toBt(p);
+            triangle[1] = toBt(q);
+            triangle[2] = toBt(r);
+            callback->processTriangle(triangle, 0, tree.triangleOrder()[slot]);
+        }
+    }
+}
+
+void MeshShape::calculateLocalInertia(btScalar mass, btVector3& inertia) const {
+    if (mass_.closed) {
+        const double density = double(mass) / mass_.volume;
+        inertia.setValue(btScalar(density * mass_.inertia(0, 0)),
+                         btScalar(density * mass_.inertia(1, 1)),
+                         btScalar(density * mass_.inertia(2, 2)));
+        return;
+    }
+    const Vec3 size = boundsHi_ - boundsLo_;
+    const double m = double(mass) / 12;
+    inertia.setValue(btScalar(m * (size.y() * size.y() + size.z() * size.z())),
+                     btScalar(m * (size.x() * size.x() + size.z() * size.z())),
+                     btScalar(m * (size.x() * size.x() + size.y() * size.y())));
+}
+
+void MeshShape::setLocalScaling(const btVector3& scaling) {
+    for (int k = 0; k < 3; ++k) {
+        if (!(std::isfinite(double(scaling[k])) && scaling[k] > 0)) {
+            throw std::invalid_argument("kolize::MeshShape: mesh '" + base_->mesh().name() +
+                                        "': local scaling " + formatScale(scaling) +
+                                        " must be finite and positive in every component");
+        }
+    }
+    if (scaling == scaling_) {
+        return;
+    }
+    if (scaling == btVector3(1, 1, 1)) {
+        adoptModel(base_);
+    } else {
+        const TriangleMesh& mesh = base_->mesh();
+        std::vector<Vec3> vertices = mesh.vertices();
+        const Vec3 factor = toVec3(scaling);
+        for (Vec3& v : vertices) {
+            v = v.cwiseProduct(factor);
+        }
+        TriangleMesh scaled(mesh.name(), std::move(vertices), mesh.triangles());
+        adoptModel(std::make_shared<const MeshModel>(
+            std::make_shared<const TriangleMesh>(std::move(scaled)), base_->settings()));
+    }
+    scaling_ = scaling;
+}
+
+// ---------------------------------------------------------------------------------------
+// MeshMeshAlgorithm
+
+struct MeshMeshAlgorithm::State {
+    narrowphase::MeshQuery query;
+    std::vector<MeshContact> contacts;
+};
+
+struct BvhMeshAlgorithm::State {
+    narrowphase::MeshQuery query;
+    std::vector<MeshContact> contacts;
+};
+
+const std::vector<MeshContact>& MeshMeshAlgorithm::lastContacts() const {
+    return state_->contacts;
+}
+
+const std::vector<MeshContact>& BvhMeshAlgorithm::lastContacts() const {
+    return state_->contacts;
+}
+
+MeshMeshAlgorithm::MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                                     const btCollisionObjectWrapper* body0,
+                                     const btCollisionObjectWrapper* body1)
+    : btActivatingCollisionAlgorithm(ci, body0, body1),
+      manifold_(ci.m_manifold),
+      state_(std::make_unique<State>()) {
+    if (!manifold_) {
+        manifold_ =
+            m_dispatcher->getNewManifold(body0->getCollisionObject(), body1->getCollisionObject());
+        ownManifold_ = true;
+    }
+}
+
+MeshMeshAlgorithm::~MeshMeshAlgorithm() {
+    if (ownManifold_ && manifold_) {
+        m_dispatcher->releaseManifold(manifold_);
+    }
+}
+
+void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
+                                         const btCollisionObjectWrapper* body1,
+                                         const btDispatcherInfo&, btManifoldResult* resultOut) {
+    state_->contacts.clear();
+    resultOut->setPersistentManifold(manifold_);
+    const auto* shapeA = static_cast<const MeshShape*>(body0->getCollisionShape());
+    const auto* shapeB = static_cast<const MeshShape*>(body1->getCollisionShape());
+    // A body whose transform went non-finite gets no contacts (the query refuses it).
+    if (finitePose(body0->getWorldTransform()) && finitePose(body1->getWorldTransform())) {
+        const Pose poseA = toPose(body0->getWorldTransform());
+        const Pose poseB = toPose(body1->getWorldTransform());
+        const QueryResult& result =
+            state_->query.run(shapeA->model(), poseA, shapeB->model(), poseB, contactSettings());
+        if (result.intersecting) {
+            buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
+                          RelativePose(poseA, poseB), contactScratch, state_->contacts);
+            toWorld(state_->contacts, poseA);
+            emit(state_->contacts, true, resultOut);
+        }
+    }
+    if (ownManifold_) {
+        resultOut->refreshContactPoints();
+    }
+}
+
+btScalar MeshMeshAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
+                                                  const btDispatcherInfo&, btManifoldResult*) {
+    return btScalar(1);
+}
+
+void MeshMeshAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
+    if (manifold_ && ownManifold_) {
+        manifolds.push_back(manifold_);
+    }
+}
+
+btCollisionAlgorithm* MeshMeshAlgorithm::CreateFunc::CreateCollisionAlgorithm(
+    btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+    const btCollisionObjectWrapper* body1) {
+    void* memory = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(MeshMeshAlgorithm));
+    return new (memory) MeshMeshAlgorithm(ci, body0, body1);
+}
+
+// ---------------------------------------------------------------------------------------
+// ConvexMeshAlgorithm: btConvexConcaveCollisionAlgorithm's triangle path, never its SDF one.
+
+ConvexMeshAlgorithm::ConvexMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                                         const btCollisionObjectWrapper* body0,
+                                         const btCollisionObjectWrapper* body1, bool meshFirst)
+    : btActivatingCollisionAlgorithm(ci, body0, body1),
+      triangles_(ci.m_dispatcher1, body0, body1, meshFirst),
+      meshFirst_(meshFirst) {}
+
+ConvexMeshAlgorithm::~ConvexMeshAlgorithm() = default;
+
+void ConvexMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
+                                           const btCollisionObjectWrapper* body1,
+                                           const btDispatcherInfo& info,
+                                           btManifoldResult* resultOut) {
+    const btCollisionObjectWrapper* convex = meshFirst_ ? body1 : body0;
+    const btCollisionObjectWrapper* mesh = meshFirst_ ? body0 : body1;
+    const auto* shape = static_cast<const MeshShape*>(mesh->getCollisionShape());
+    resultOut->setPersistentManifold(triangles_.m_manifoldPtr);
+    triangles_.setTimeStepAndCounters(shape->getMargin(), info, convex, mesh, resultOut);
+    triangles_.m_manifoldPtr->setBodies(convex->getCollisionObject(), mesh->getCollisionObject());
+    shape->processAllTriangles(&triangles_, triangles_.getAabbMin(), triangles_.getAabbMax());
+    resultOut->refreshContactPoints();
+    triangles_.clearWrapperData();
+}
+
+btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
+                                                    const btDispatcherInfo&, btManifoldResult*) {
+    return btScalar(1);
+}
+
+void ConvexMeshAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
+    if (triangles_.m_manifoldPtr) {
+        manifolds.push_back(triangles_.m_manifoldPtr);
+    }
+}
+
+btCollisionAlgorithm* ConvexMeshAlgorithm::CreateFunc::CreateCollisionAlgorithm(
+    btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+    const btCollisionObjectWrapper* body1) {
+    void* memory = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(ConvexMeshAlgorithm));
+    return new (memory) ConvexMeshAlgorithm(ci, body0, body1, false);
+}
+
+btCollisionAlgorithm* ConvexMeshAlgorithm::SwappedCreateFunc::CreateCollisionAlgorithm(
+    btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+    const btCollisionObjectWrapper* body1) {
+    void* memory = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(ConvexMeshAlgorithm));
+    return new (memory) ConvexMeshAlgorithm(ci, body0, body1, true);
+}
+
+// ---------------------------------------------------------------------------------------
+// BvhMeshAlgorithm
+
+namespace {
+
+/// Collects scenery triangles in world coordinates, vertices welded where exactly equal.
+class SceneryCollector : public btTriangleCallback {
+  public:
+    SceneryCollector(const Pose& scenery) : pose_(scenery) {}
+    void processTriangle(btVector3* triangle, int partId, int triangleIndex) override {
+        Index3 t;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 world = pose_.rotation * toVec3(triangle[k]) + pose_.translation;
+            const std::array<double, 3> key{world.x(), world.y(), world.z()};
+            auto [it, inserted] = index_.emplace(key, std::int32_t(vertices.size()));
+            if (inserted) {
+                vertices.push_back(world);
+            }
+            t[k] = it->second;
+        }
+        triangles.push_back(t);
+        ids.emplace_back(partId, triangleIndex);
+    }
+    std::vector<Vec3> vertices;
+    std::vector<Index3> triangles;
+    std::vector<std::pair<int, int>> ids;
+
+  private:
+    Pose pose_;
+    std::map<std::array<double, 3>, std::int32_t> index_;
+};
+
+}  // namespace
+
+BvhMeshAlgorithm::BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                                   const btCollisionObjectWrapper* body0,
+                                   const btCollisionObjectWrapper* body1, bool meshFirst)
+    : btActivatingCollisionAlgorithm(ci, body0, body1),
+      manifold_(ci.m_manifold),
+      meshFirst_(meshFirst),
+      state_(std::make_unique<State>()) {
+    if (!manifold_) {
+        manifold_ =
+            m_dispatcher->getNewManifold(body0->getCollisionObject(), body1->getCollisionObject());
+        ownManifold_ = true;
+    }
+}
+
+BvhMeshAlgorithm::~BvhMeshAlgorithm() {
+    if (ownManifold_ && manifold_) {
+        m_dispatcher->releaseManifold(manifold_);
+    }
+}
+
+void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
+                                        const btCollisionObjectWrapper* body1,
+                                        const btDispatcherInfo&, btManifoldResult* resultOut) {
+    state_->contacts.clear();
+    resultOut->setPersistentManifold(manifold_);
+    const btCollisionObjectWrapper* meshWrap = meshFirst_ ? body0 : body1;
+    const btCollisionObjectWrapper* sceneryWrap = meshFirst_ ? body1 : body0;
+    const auto* shape = static_cast<const MeshShape*>(meshWrap->getCollisionShape());
+    const auto* scenery = static_cast<const btConcaveShape*>(sceneryWrap->getCollisionShape());
+    if (finitePose(meshWrap->getWorldTransform()) && finitePose(sceneryWrap->getWorldTransform())) {
+        // The mesh's box in the scenery's frame, and the scenery's triangles in it.
+        const btTransform meshInScenery =
+            sceneryWrap->getWorldTransform().inverse() * meshWrap->getWorldTransform();
+        btVector3 lo, hi;
+        shape->getAabb(meshInScenery, lo, hi);
+        SceneryCollector collector(toPose(sceneryWrap->getWorldTransform()));
+        scenery->processAllTriangles(&collector, lo, hi);
+        if (!collector.triangles.empty()) {
+            std::vector<std::pair<int, int>> ids = std::move(collector.ids);
+            const MeshModel sceneryModel(std::make_shared<const TriangleMesh>(
+                                             "bullet scenery", std::move(collector.vertices),
+                                             std::move(collector.triangles)),
+                                         shape->model().settings());
+            const Pose meshPose = toPose(meshWrap->getWorldTransform());
+            const Pose identity;
+            // A fresh model each call: the traversal front would point into the last one.
+            QuerySettings settings = contactSettings();
+            settings.use_front = false;
+            const QueryResult& result =
+                state_->query.run(shape->model(), meshPose, sceneryModel, identity, settings);
+            if (result.intersecting) {
+                buildContacts(result, shape->model().mesh(), sceneryModel.mesh(),
+                              RelativePose(meshPose, identity), contactScratch, state_->contacts);
+                toWorld(state_->contacts, meshPose);
+                for (MeshContact& c : state_->contacts) {
+                    c.partY = ids[c.triangleY].first;
+                    c.triangleY = ids[c.triangleY].second;
+                }
+                emit(state_->contacts, meshFirst_, resultOut);
+            }
+        }
+    }
+    if (ownManifold_) {
+        resultOut->refreshContactPoints();
+    }
+}
+
+btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
+                                                 const btDispatcherInfo&, btManifoldResult*) {
+    return btScalar(1);
+}
+
+void BvhMeshAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
+    if (manifold_ && ownManifold_) {
+        manifolds.push_back(manifold_);
+    }
+}
+
+btCollisionAlgorithm* BvhMeshAlgorithm::CreateFunc::CreateCollisionAlgorithm(
+    btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+    const btCollisionObjectWrapper* body1) {
+    void* memory = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(BvhMeshAlgorithm));
+    return new (memory) BvhMeshAlgorithm(ci, body0, body1, true);
+}
+
+btCollisionAlgorithm* BvhMeshAlgorithm::SwappedCreateFunc::CreateCollisionAlgorithm(
+    btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
+    const btCollisionObjectWrapper* body1) {
+    void* memory = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(BvhMeshAlgorithm));
+    return new (memory) BvhMeshAlgorithm(ci, body0, body1, false);
+}
+
+// ---------------------------------------------------------------------------------------
+
+void registerNarrowphase(btCollisionDispatcher* dispatcher) {
+    if (!dispatcher) {
+        throw std::invalid_argument("kolize::registerNarrowphase: null dispatcher");
+    }
+    if (btCollisionConfiguration* configuration = dispatcher->getCollisionConfiguration()) {
+        const std::size_t largest = std::max(
+            {sizeof(MeshMeshAlgorithm), sizeof(ConvexMeshAlgorithm), sizeof(BvhMeshAlgorithm)});
+        const btPoolAllocator* pool = configuration->getCollisionAlgorithmPool();
+        if (pool && std::size_t(pool->getElementSize()) < largest) {
+            throw std::invalid_argument(
+                "kolize::registerNarrowphase: the collision configuration's algorithm pool "
+                "holds " +
+                std::to_string(pool->getElementSize()) +
+                "-byte elements, kolize's algorithms need " + std::to_string(largest));
+        }
+    }
+    static MeshMeshAlgorithm::CreateFunc meshMesh;
+    static ConvexMeshAlgorithm::CreateFunc convexMesh;
+    static ConvexMeshAlgorithm::SwappedCreateFunc meshConvex;
+    static BvhMeshAlgorithm::CreateFunc meshScenery;
+    static BvhMeshAlgorithm::SwappedCreateFunc sceneryMesh;
+    const int mesh = CUSTOM_CONCAVE_SHAPE_TYPE;
+    auto both = [&](int type0, int type1, btCollisionAlgorithmCreateFunc* create) {
+        dispatcher->registerCollisionCreateFunc(type0, type1, create);
+        dispatcher->registerClosestPointsCreateFunc(type0, type1, create);
+    };
+    both(mesh, mesh, &meshMesh);
+    for (int type = 0; type < CONCAVE_SHAPES_START_HERE; ++type) {
+        if (type == IMPLICIT_CONVEX_SHAPES_START_HERE) {
+            continue;  // a marker, not a shape type
+        }
+        both(type, mesh, &convexMesh);
+        both(mesh, type, &meshConvex);
+    }
+    for (int scenery :
+         {int(TRIANGLE_MESH_SHAPE_PROXYTYPE), int(SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE)}) {
+        both(mesh, scenery, &meshScenery);
+        both(scenery, mesh, &sceneryMesh);
+    }
+}
+
+}  // namespace kolize
