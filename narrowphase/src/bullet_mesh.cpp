@@ -610,27 +610,14 @@ void MeshShape::setLocalScaling(const btVector3& scaling) {
 // ---------------------------------------------------------------------------------------
 // MeshMeshAlgorithm
 
-struct MeshMeshAlgorithm::State {
+struct MeshContactAlgorithm::State {
     narrowphase::MeshQuery query;
     std::vector<MeshContact> contacts;
 };
 
-struct BvhMeshAlgorithm::State {
-    narrowphase::MeshQuery query;
-    std::vector<MeshContact> contacts;
-};
-
-const std::vector<MeshContact>& MeshMeshAlgorithm::lastContacts() const {
-    return state_->contacts;
-}
-
-const std::vector<MeshContact>& BvhMeshAlgorithm::lastContacts() const {
-    return state_->contacts;
-}
-
-MeshMeshAlgorithm::MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
-                                     const btCollisionObjectWrapper* body0,
-                                     const btCollisionObjectWrapper* body1)
+MeshContactAlgorithm::MeshContactAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                                           const btCollisionObjectWrapper* body0,
+                                           const btCollisionObjectWrapper* body1)
     : btActivatingCollisionAlgorithm(ci, body0, body1),
       manifold_(ci.m_manifold),
       state_(std::make_unique<State>()) {
@@ -641,11 +628,31 @@ MeshMeshAlgorithm::MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo&
     }
 }
 
-MeshMeshAlgorithm::~MeshMeshAlgorithm() {
+MeshContactAlgorithm::~MeshContactAlgorithm() {
     if (ownManifold_ && manifold_) {
         m_dispatcher->releaseManifold(manifold_);
     }
 }
+
+const std::vector<MeshContact>& MeshContactAlgorithm::lastContacts() const {
+    return state_->contacts;
+}
+
+btScalar MeshContactAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
+                                                     const btDispatcherInfo&, btManifoldResult*) {
+    return btScalar(1);
+}
+
+void MeshContactAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
+    if (manifold_ && ownManifold_) {
+        manifolds.push_back(manifold_);
+    }
+}
+
+MeshMeshAlgorithm::MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                                     const btCollisionObjectWrapper* body0,
+                                     const btCollisionObjectWrapper* body1)
+    : MeshContactAlgorithm(ci, body0, body1) {}
 
 void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
                                          const btCollisionObjectWrapper* body1,
@@ -669,17 +676,6 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     }
     if (ownManifold_) {
         resultOut->refreshContactPoints();
-    }
-}
-
-btScalar MeshMeshAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
-                                                  const btDispatcherInfo&, btManifoldResult*) {
-    return btScalar(1);
-}
-
-void MeshMeshAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
-    if (manifold_ && ownManifold_) {
-        manifolds.push_back(manifold_);
     }
 }
 
@@ -779,22 +775,7 @@ class SceneryCollector : public btTriangleCallback {
 BvhMeshAlgorithm::BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
                                    const btCollisionObjectWrapper* body0,
                                    const btCollisionObjectWrapper* body1, bool meshFirst)
-    : btActivatingCollisionAlgorithm(ci, body0, body1),
-      manifold_(ci.m_manifold),
-      meshFirst_(meshFirst),
-      state_(std::make_unique<State>()) {
-    if (!manifold_) {
-        manifold_ =
-            m_dispatcher->getNewManifold(body0->getCollisionObject(), body1->getCollisionObject());
-        ownManifold_ = true;
-    }
-}
-
-BvhMeshAlgorithm::~BvhMeshAlgorithm() {
-    if (ownManifold_ && manifold_) {
-        m_dispatcher->releaseManifold(manifold_);
-    }
-}
+    : MeshContactAlgorithm(ci, body0, body1), meshFirst_(meshFirst) {}
 
 void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
                                         const btCollisionObjectWrapper* body1,
@@ -840,17 +821,6 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     }
     if (ownManifold_) {
         resultOut->refreshContactPoints();
-    }
-}
-
-btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
-                                                 const btDispatcherInfo&, btManifoldResult*) {
-    return btScalar(1);
-}
-
-void BvhMeshAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
-    if (manifold_ && ownManifold_) {
-        manifolds.push_back(manifold_);
     }
 }
 

@@ -146,34 +146,45 @@ struct MeshContact {
     std::int32_t partX = 0, triangleX = -1, partY = 0, triangleY = -1;
 };
 
-/// MeshShape against MeshShape: the exact mesh query, contacts from its triangle pairs.
-class MeshMeshAlgorithm : public btActivatingCollisionAlgorithm {
+/// What the two exact mesh algorithms share: the manifold (the dispatcher's, or one of its
+/// own), the mesh query and the last contacts (off Bullet's fixed-size algorithm pool), no
+/// time of impact yet.
+class MeshContactAlgorithm : public btActivatingCollisionAlgorithm {
   public:
-    MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
-                      const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1);
-    ~MeshMeshAlgorithm() override;
-    void processCollision(const btCollisionObjectWrapper* body0,
-                          const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
-                          btManifoldResult* resultOut) override;
+    ~MeshContactAlgorithm() override;
     /// 1 (no time of impact yet: continuous collision is a later stage).
     btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
                                    const btDispatcherInfo& info,
                                    btManifoldResult* resultOut) override;
     void getAllContactManifolds(btManifoldArray& manifolds) override;
-    /// The contacts made by the last processCollision (world frame, X = body0).
+    /// The contacts made by the last processCollision (world frame; X = body0 for two meshes,
+    /// the MeshShape against scenery).
     const std::vector<MeshContact>& lastContacts() const;
+
+  protected:
+    MeshContactAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                         const btCollisionObjectWrapper* body0,
+                         const btCollisionObjectWrapper* body1);
+    struct State;
+    btPersistentManifold* manifold_ = nullptr;
+    bool ownManifold_ = false;
+    std::unique_ptr<State> state_;
+};
+
+/// MeshShape against MeshShape: the exact mesh query, contacts from its triangle pairs.
+class MeshMeshAlgorithm : public MeshContactAlgorithm {
+  public:
+    MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
+                      const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1);
+    void processCollision(const btCollisionObjectWrapper* body0,
+                          const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
+                          btManifoldResult* resultOut) override;
 
     struct CreateFunc : btCollisionAlgorithmCreateFunc {
         btCollisionAlgorithm* CreateCollisionAlgorithm(
             btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* body0,
             const btCollisionObjectWrapper* body1) override;
     };
-
-  private:
-    struct State;  // the query and the contacts, off Bullet's fixed-size algorithm pool
-    btPersistentManifold* manifold_ = nullptr;
-    bool ownManifold_ = false;
-    std::unique_ptr<State> state_;
 };
 
 /// A convex shape against a MeshShape (either order): the tree gives the triangles in the
@@ -214,21 +225,14 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 /// narrowphase mesh in world coordinates (vertices welded where exactly equal, rebuilt each
 /// call: O(k log k) for k triangles), queried exactly against the mesh. Contacts as for two
 /// meshes, the scenery's part and triangle index on each point.
-class BvhMeshAlgorithm : public btActivatingCollisionAlgorithm {
+class BvhMeshAlgorithm : public MeshContactAlgorithm {
   public:
     BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
                      const btCollisionObjectWrapper* body0, const btCollisionObjectWrapper* body1,
                      bool meshFirst);
-    ~BvhMeshAlgorithm() override;
     void processCollision(const btCollisionObjectWrapper* body0,
                           const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
                           btManifoldResult* resultOut) override;
-    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
-                                   const btDispatcherInfo& info,
-                                   btManifoldResult* resultOut) override;
-    void getAllContactManifolds(btManifoldArray& manifolds) override;
-    /// The contacts made by the last processCollision (world frame, X = the MeshShape).
-    const std::vector<MeshContact>& lastContacts() const;
 
     struct CreateFunc : btCollisionAlgorithmCreateFunc {
         btCollisionAlgorithm* CreateCollisionAlgorithm(
@@ -243,11 +247,7 @@ class BvhMeshAlgorithm : public btActivatingCollisionAlgorithm {
     };
 
   private:
-    struct State;
-    btPersistentManifold* manifold_ = nullptr;
-    bool ownManifold_ = false;
     bool meshFirst_;
-    std::unique_ptr<State> state_;
 };
 
 /// Registers the algorithms above on `dispatcher`, in both its contact-point
