@@ -790,3 +790,183 @@ TEST(Auto, ResetPoolAfterASwitchToSweepStillFindsPairs) {
 
 }  // namespace
 }  // namespace kolize
+
+namespace kolize {
+namespace {
+
+// The pair store's bulk mode (full searches): the radix sort of the candidates' keys against
+// std::sort, and the round trip from indexed to bulk mode and back keeping every pair, the
+// order, and the triggers the adapter asks for.
+TEST(PairStore, SortKeysMatchesStdSortAndBulkModeKeepsEveryPair) {
+    std::mt19937_64 random(11);
+    auto expectSorted = [&](std::vector<std::uint64_t> keys, const char* what) {
+        std::vector<std::uint64_t> reference = keys, scratch;
+        std::sort(reference.begin(), reference.end());
+        reference.erase(std::unique(reference.begin(), reference.end()), reference.end());
+        PairStore::sortKeys(keys, scratch);
+        EXPECT_EQ(keys, reference) << what;
+    };
+    expectSorted({}, "empty");
+    expectSorted({42}, "one key");
+    expectSorted(std::vector<std::uint64_t>(100, 7), "all equal (no byte varies)");
+    std::vector<std::uint64_t> wide, pairs, topByte;
+    for (int i = 0; i < 5000; ++i) {
+        wide.push_back(random());
+        pairs.push_back(PairStore::keyOf(ObjectId(random() % 300), ObjectId(random() % 300)));
+        topByte.push_back((random() % 4) << 56 | 5);
+    }
+    expectSorted(wide, "64 random bits");
+    expectSorted(pairs, "pair keys with repeats");
+    expectSorted(topByte, "only the top byte varies");
+
+    PairStore store;
+    std::map<std::uint64_t, double> reference;  // key -> status marker
+    std::uniform_int_distribution<int> id(0, 199);
+    for (int i = 0; i < 3000; ++i) {
+        const ObjectId a = ObjectId(id(random)), b = ObjectId(id(random));
+        if (a == b) {
+            continue;
+        }
+        if (random() % 5 == 0 && !reference.empty()) {  // erase one: the order is disturbed
+            const std::uint32_t at = std::uint32_t(random() % store.size());
+            reference.erase(PairStore::keyOf(store[at]));
+            store.erase(at);
+            continue;
+        }
+        bool inserted = false;
+        const std::uint32_t at = store.findOrInsert(a, b, inserted, double(random() % 100));
+        store[at].status = PairStore::Status::InCache;
+        reference[PairStore::keyOf(a, b)] = 1;
+    }
+    ASSERT_NO_THROW(store.validate());
+    ASSERT_GT(reference.size(), 1000u);
+    store.unindex();
+    ASSERT_FALSE(store.indexed());
+    ASSERT_NO_THROW(store.validate());
+    ASSERT_EQ(store.size(), reference.size());
+    std::size_t at = 0;
+    for (const auto& entry : reference) {  // sorted like the map, nothing lost
+        ASSERT_EQ(PairStore::keyOf(store[std::uint32_t(at)]), entry.first);
+        ASSERT_LT(store[std::uint32_t(at)].slack, 0);
+        ++at;
+    }
+    EXPECT_EQ(store.nextTrigger(3), -HUGE_VAL) << "bulk mode: every pair is due";
+    EXPECT_THROW(store.find(1, 2), std::logic_error);
+    bool inserted = false;
+    EXPECT_THROW(store.findOrInsert(1, 2, inserted), std::logic_error);
+    // Back to indexed: object id's triggers all triggerOf(id).
+    auto triggerOf = [](ObjectId object) { return object % 3 == 0 ? -HUGE_VAL : double(object); };
+    store.index(triggerOf);
+    ASSERT_NO_THROW(store.validate());
+    std::map<ObjectId, std::size_t> degree;
+    for (const auto& entry : reference) {
+        const ObjectId a = ObjectId(entry.first >> 32), b = ObjectId(entry.first & 0xffffffffu);
+        ASSERT_NE(store.find(a, b), PairStore::kNone);
+        ++degree[a];
+        ++degree[b];
+    }
+    for (const auto& entry : degree) {
+        EXPECT_EQ(store.degree(entry.first), entry.second);
+        EXPECT_EQ(store.nextTrigger(entry.first), triggerOf(entry.first));
+    }
+    EXPECT_EQ(store.find(500, 501), PairStore::kNone);
+}
+
+/// A filter that, when asked about its `fire`-th pair, destroys one live proxy of the
+/// broadphase other than the two it is asked about (a callback re-entering the broadphase
+/// in the middle of a pair search).
+class DestroyingFilter : public btOverlapFilterCallback {
+  public:
+    bool needBroadphaseCollision(btBroadphaseProxy* a, btBroadphaseProxy* b) const override {
+        if (++calls == fire && broadphase != nullptr) {
+            // The last proxy: its pairs come late in the search's order (objects ascending).
+            for (auto it = boxes->rbegin(); it != boxes->rend(); ++it) {
+                if (it->first != a && it->first != b) {
+                    btBroadphaseProxy* victim = const_cast<btBroadphaseProxy*>(it->first);
+                    boxes->erase(it->first);
+                    broadphase->destroyProxy(victim, nullptr);
+                    ++destroyed;
+                    break;
+                }
+            }
+        }
+        return true;
+    }
+    btBroadphaseInterface* broadphase = nullptr;
+    BoxMap* boxes = nullptr;
+    mutable int calls = 0;
+    mutable int fire = -1;
+    mutable int destroyed = 0;
+};
+
+// Full searches merge all candidates at once (the store's bulk mode) and only then tell
+// Bullet's cache: a filter callback that destroys a proxy in the middle of those adds must
+// leave no pair of the destroyed proxy behind and lose no other pair, in full frames and in
+// the incremental frames that follow (which rebuild the store's index). Seed 5.
+TEST(BulkSearch, FilterThatDestroysAProxyDuringAFullSearchLosesNothing) {
+    for (const std::string& name : broadphaseNames()) {
+        if (!isExactBroadphase(name)) {
+            continue;
+        }
+        SCOPED_TRACE(name);
+        std::unique_ptr<btBroadphaseInterface> broadphase = makeBroadphase(name);
+        DestroyingFilter filter;
+        BoxMap boxes;
+        filter.broadphase = broadphase.get();
+        filter.boxes = &boxes;
+        broadphase->getOverlappingPairCache()->setOverlapFilterCallback(&filter);
+        std::mt19937 random(5);
+        std::uniform_real_distribution<double> position(-12, 12), size(0.5, 3);
+        static char client;
+        auto randomBox = [&](ProxyBox& box) {
+            const btVector3 lo(btScalar(position(random)), btScalar(position(random)),
+                               btScalar(position(random)));
+            box.aabbMin = lo;
+            box.aabbMax = lo + btVector3(btScalar(size(random)), btScalar(size(random)),
+                                         btScalar(size(random)));
+        };
+        for (int i = 0; i < 300; ++i) {
+            ProxyBox box;
+            randomBox(box);
+            box.proxy =
+                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+            boxes[box.proxy] = box;
+        }
+        std::size_t pairsSeen = 0;
+        for (int frame = 0; frame < 40; ++frame) {
+            // Frames 0..19: everything jumps (full searches); then a few move (incremental).
+            const bool all = frame < 20;
+            for (auto& entry : boxes) {
+                if (all || random() % 30 == 0) {
+                    randomBox(entry.second);
+                    broadphase->setAabb(const_cast<btBroadphaseProxy*>(entry.first),
+                                        entry.second.aabbMin, entry.second.aabbMax, nullptr);
+                }
+            }
+            filter.calls = 0;
+            filter.fire = frame % 4 == 0 ? 1 + int(random() % 50) : -1;
+            broadphase->calculateOverlappingPairs(nullptr);
+            filter.fire = -1;  // the oracle below asks the filter too
+            // At once: the victim's pairs are gone, every other pair is in.
+            std::vector<ProxyBox> live;
+            for (const auto& entry : boxes) {
+                live.push_back(entry.second);
+            }
+            const btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();
+            const std::vector<UidPair> truth = exactPairs(live, cache);
+            ASSERT_EQ(cachedPairs(*cache), truth) << "frame " << frame;
+            pairsSeen += truth.size();
+            const FramePairs again = searchPairs(*broadphase, boxes, nullptr);
+            ASSERT_EQ(again.cached, again.truth) << "frame " << frame;
+            auto* adapter = dynamic_cast<BroadphaseAdapter*>(broadphase.get());
+            ASSERT_NE(adapter, nullptr);
+            ASSERT_NO_THROW(adapter->validate()) << "frame " << frame;
+        }
+        EXPECT_GE(filter.destroyed, 8) << "the callback must have destroyed proxies";
+        EXPECT_GT(pairsSeen, 40u * 100) << "the scene must have pairs";
+        broadphase->getOverlappingPairCache()->setOverlapFilterCallback(nullptr);
+    }
+}
+
+}  // namespace
+}  // namespace kolize

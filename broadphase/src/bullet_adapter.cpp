@@ -227,6 +227,7 @@ void BroadphaseAdapter::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dis
     // While this runs, callbacks of the pair cache may destroy other proxies: their pairs
     // are then erased at the end, so that this walk over the slot's pairs stays valid.
     ++deferErasures_;
+    indexPairs();
     std::vector<std::uint32_t> own;
     pairs_.appendPairsOf(slot, own);
     if (cacheHoldsOnlyOurs()) {
@@ -277,6 +278,9 @@ void BroadphaseAdapter::erasePairs(std::vector<std::uint32_t>& doomed) {
 }
 
 void BroadphaseAdapter::releasePendingSlots() {
+    if (!pendingFree_.empty()) {
+        indexPairs();
+    }
     for (ObjectId slot : pendingFree_) {
         pairs_.appendPairsOf(slot, doomed_);  // all Apart by now
         erasePairs(doomed_);
@@ -474,7 +478,11 @@ bool BroadphaseAdapter::beginPairs() {
         forceFullSearch_ = false;
         return true;
     }
-    return counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
+    const bool full = counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
+    if (!full) {
+        indexPairs();  // certificates and queries need it (a no-op unless after a bulk frame)
+    }
+    return full;
 }
 
 void BroadphaseAdapter::checkCacheForLostPairs() {
@@ -484,6 +492,7 @@ void BroadphaseAdapter::checkCacheForLostPairs() {
     // Someone else removed (or added) pairs: look ours up, and test again every pair that
     // is gone, so it is added again if its boxes still overlap.
     ++counters_.cacheChecks;
+    const bool indexed = pairs_.indexed();  // in bulk mode every trigger counts as -inf
     for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
         PairStore::Pair& pair = pairs_[at];
         if (pair.status != PairStore::Status::InCache ||
@@ -501,7 +510,9 @@ void BroadphaseAdapter::checkCacheForLostPairs() {
         }
         for (int side = 0; side < 2; ++side) {
             const ObjectId id = pair.object[side];
-            pairs_.setTrigger(at, side, -HUGE_VAL);
+            if (indexed) {
+                pairs_.setTrigger(at, side, -HUGE_VAL);
+            }
             if (frameKind_[id] == 0) {
                 processing_.push_back(Moved{id, kExactMoved});
             }
@@ -636,27 +647,109 @@ void BroadphaseAdapter::applyFilter(std::uint32_t at, bool again, btDispatcher* 
     }
 }
 
-void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, bool full, std::size_t candidates) {
+void BroadphaseAdapter::finishPairs(btDispatcher* dispatcher, std::size_t candidates) {
     const bool everyFrame = settings_.filters == FilterEvaluation::EveryFrame;
     testedThisFrame_ = 0;
     // No pair is erased until the end (callbacks may destroy proxies): indices hold.
     ++deferErasures_;
-    if (full) {
-        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
-            if (pairs_[at].stamp != stamp_) {
-                uncache(at, dispatcher);  // the core boxes no longer overlap
-                doomed_.push_back(at);
-            } else if (pairs_[at].slack < 0) {
-                lookAtPair(at, dispatcher, everyFrame);
-            }
-        }
-    }
     for (const Moved& moved : processing_) {
         if (state_[moved.slot] == SlotState::Live) {
             lookAtDuePairs(moved.slot, dispatcher, everyFrame);
         }
     }
-    endSearch(dispatcher, full, candidates);
+    endSearch(dispatcher, false, candidates);
+}
+
+void BroadphaseAdapter::finishBulkPairs(btDispatcher* dispatcher, std::size_t candidates) {
+    const bool everyFrame = settings_.filters == FilterEvaluation::EveryFrame;
+    testedThisFrame_ = 0;
+    PairStore::sortKeys(bulkKeys_, bulkScratch_);
+    pairs_.unindex();
+    // 1. The merge, without a call into Bullet. Each candidate gets the exact test; a
+    // status change that Bullet's cache must see is listed for step 2. A cached pair
+    // whose core boxes left stays (stamp 0) until step 2 has uncached it.
+    bulkNext_.clear();
+    bulkNext_.reserve(bulkKeys_.size());
+    bulkChanges_.clear();
+    const std::size_t oldCount = pairs_.size();
+    std::size_t old = 0;
+    auto leave = [&](const PairStore::Pair& pair) {
+        if (pair.status == PairStore::Status::InCache) {
+            bulkChanges_.push_back(static_cast<std::uint32_t>(bulkNext_.size()));
+            bulkNext_.push_back(pair);
+            bulkNext_.back().stamp = 0;
+        } else if (pair.status == PairStore::Status::Rejected) {
+            --overlapping_;
+        }
+    };
+    for (const std::uint64_t key : bulkKeys_) {
+        while (old < oldCount && PairStore::keyOf(pairs_[old]) < key) {
+            leave(pairs_[old++]);
+        }
+        PairStore::Pair pair{};
+        if (old < oldCount && PairStore::keyOf(pairs_[old]) == key) {
+            pair = pairs_[old++];
+        } else {
+            pair.object[0] = ObjectId(key >> 32);
+            pair.object[1] = ObjectId(key & 0xffffffffu);
+            pair.status = PairStore::Status::Apart;
+        }
+        pair.slack = -1;
+        pair.stamp = stamp_;
+        pair.tested = stamp_;
+        ++testedThisFrame_;
+        const bool overlap = overlaps(boxes_[pair.object[0]], boxes_[pair.object[1]]);
+        if (overlap != (pair.status != PairStore::Status::Apart)) {
+            if (pair.status == PairStore::Status::Rejected) {
+                pair.status = PairStore::Status::Apart;
+                --overlapping_;
+            } else {
+                bulkChanges_.push_back(static_cast<std::uint32_t>(bulkNext_.size()));
+            }
+        } else if (overlap && everyFrame) {
+            pair.tested = 0;  // endSearch asks its filters again
+        }
+        bulkNext_.push_back(pair);
+    }
+    while (old < oldCount) {
+        leave(pairs_[old++]);
+    }
+    pairs_.replaceAll(bulkNext_);
+    bulkKeys_.clear();
+    for (const Moved& moved : processing_) {
+        frameKind_[moved.slot] = 0;  // every pair tested: none is due
+    }
+    // 2. The changes, in key order. Callbacks may destroy proxies (their destroyProxy
+    // indexes the store, indices hold) or create them (seen at the next search).
+    ++deferErasures_;
+    for (const std::uint32_t at : bulkChanges_) {
+        const PairStore::Pair& pair = pairs_[at];
+        if (state_[pair.object[0]] != SlotState::Live ||
+            state_[pair.object[1]] != SlotState::Live) {
+            continue;  // destroyed meanwhile: its pairs are out of the cache
+        }
+        if (pair.status == PairStore::Status::Apart) {
+            ++overlapping_;
+            applyFilter(at, false, dispatcher);
+        } else {
+            uncache(at, dispatcher);
+        }
+    }
+    // The pairs that left, and those of proxies destroyed meanwhile, are all Apart now.
+    auto gone = [&](const PairStore::Pair& pair) {
+        return pair.stamp != stamp_ || state_[pair.object[0]] != SlotState::Live ||
+               state_[pair.object[1]] != SlotState::Live;
+    };
+    if (pairs_.indexed()) {
+        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+            if (gone(pairs_[at])) {
+                doomed_.push_back(at);
+            }
+        }
+    } else {
+        pairs_.eraseIf(gone);
+    }
+    endSearch(dispatcher, true, candidates);
 }
 
 void BroadphaseAdapter::endSearch(btDispatcher* dispatcher, bool full, std::size_t candidates) {
@@ -691,6 +784,7 @@ void BroadphaseAdapter::endSearch(btDispatcher* dispatcher, bool full, std::size
 
 void BroadphaseAdapter::finishTrackedPairs(btDispatcher* dispatcher) {
     testedThisFrame_ = 0;
+    indexPairs();
     // The store holds exactly the overlapping pairs: a changed pair is either overlapping
     // (into the cache, filters permitting) or erased. No erasing until the end (callbacks
     // may destroy proxies): indices hold.
@@ -797,6 +891,7 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
 
 void BroadphaseAdapter::prepareCoreSwitch(bool tracking, btDispatcher* dispatcher) {
     // Every pair's status made current by an exact test (a switch is rare: O(pairs) once).
+    indexPairs();
     ++deferErasures_;
     for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
         PairStore::Pair& pair = pairs_[at];
@@ -821,13 +916,13 @@ void BroadphaseAdapter::prepareCoreSwitch(bool tracking, btDispatcher* dispatche
             travel_[slot] = 0;
         }
     }
-    if (!tracking) {
-        // No certificates yet: every pair is tested at the next (full) search.
-        for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
-            pairs_[at].slack = -1;
-            pairs_.setTrigger(at, 0, -HUGE_VAL);
-            pairs_.setTrigger(at, 1, -HUGE_VAL);
-        }
+    // Without tracking: no certificates yet, every pair is tested at the next (full)
+    // search. With it: triggers are not used (a tracking core reports the changes).
+    const double trigger = tracking ? HUGE_VAL : -HUGE_VAL;
+    for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
+        pairs_[at].slack = -1;
+        pairs_.setTrigger(at, 0, trigger);
+        pairs_.setTrigger(at, 1, trigger);
     }
 }
 
@@ -859,6 +954,10 @@ void BroadphaseAdapter::resetPool(btDispatcher* /*dispatcher*/) {
     std::vector<std::uint8_t>().swap(frameKind_);
     std::vector<double>().swap(travel_);
     std::vector<std::uint32_t>().swap(doomed_);
+    std::vector<std::uint64_t>().swap(bulkKeys_);
+    std::vector<std::uint64_t>().swap(bulkScratch_);
+    std::vector<PairStore::Pair>().swap(bulkNext_);
+    std::vector<std::uint32_t>().swap(bulkChanges_);
     std::vector<Moved>().swap(processing_);
     if (queryDepth_ == 0) {
         queryScratch_.clear();
@@ -890,7 +989,10 @@ AdapterStats BroadphaseAdapter::stats() const {
         movedKind_.capacity() + frameKind_.capacity() + travel_.capacity() * sizeof(double) +
         doomed_.capacity() * sizeof(std::uint32_t) +
         (freeSlots_.capacity() + pendingFree_.capacity() + moved_.capacity()) * sizeof(ObjectId) +
-        processing_.capacity() * sizeof(Moved) + scratch + pairs_.memoryBytes() + coreMemoryBytes();
+        processing_.capacity() * sizeof(Moved) + scratch + pairs_.memoryBytes() +
+        (bulkKeys_.capacity() + bulkScratch_.capacity()) * sizeof(std::uint64_t) +
+        bulkNext_.capacity() * sizeof(PairStore::Pair) +
+        bulkChanges_.capacity() * sizeof(std::uint32_t) + coreMemoryBytes();
     return out;
 }
 
@@ -932,7 +1034,7 @@ void BroadphaseAdapter::validate() const {
                     boxes_[slot].hi[2] != proxy->m_aabbMax.z()) {
                     fail("box of slot " + std::to_string(slot) + " invalid or out of sync");
                 }
-                if (movedKind_[slot] == 0 && !searching_ &&
+                if (movedKind_[slot] == 0 && !searching_ && pairs_.indexed() &&
                     travel_[slot] > pairs_.nextTrigger(static_cast<ObjectId>(slot))) {
                     fail("slot " + std::to_string(slot) +
                          " travelled past its trigger without being noted");
@@ -945,7 +1047,8 @@ void BroadphaseAdapter::validate() const {
                 ++parked;
                 break;
             default:
-                if (pairs_.degree(static_cast<ObjectId>(slot)) != 0 && !searching_) {
+                if (pairs_.indexed() && pairs_.degree(static_cast<ObjectId>(slot)) != 0 &&
+                    !searching_) {
                     fail("dead slot " + std::to_string(slot) + " still has pairs");
                 }
                 break;

@@ -191,10 +191,11 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     }
 
     /// One pair search, driven by CoreBroadphase::calculateOverlappingPairs:
-    /// `const bool full = beginPairs();` then, when full, keepCandidate for every pair the
-    /// core's all-pairs search finds (whose core boxes overlap); else, for each object
+    /// `const bool full = beginPairs();` then, when full (a quarter of the objects left their
+    /// core boxes, or the first search), bulkCandidate for every pair the core's all-pairs
+    /// search finds (whose core boxes overlap) and finishBulkPairs; else, for each object
     /// forEachCoreMoved visits, dropLeftCandidates and keepCandidate for each object its
-    /// core query finds. Then finishPairs.
+    /// core query finds, then finishPairs.
     bool beginPairs();
     /// True while a pair search or a destroyProxy of this broadphase is under way: a pair
     /// search started from one of their callbacks does nothing.
@@ -214,7 +215,16 @@ class BroadphaseAdapter : public btBroadphaseInterface {
         bool inserted = false;
         pairs_[pairs_.findOrInsert(a, b, inserted)].stamp = stamp_;
     }
-    void finishPairs(btDispatcher* dispatcher, bool full, std::size_t candidates);
+    /// Incremental search: looks at the due pairs of every moved object.
+    void finishPairs(btDispatcher* dispatcher, std::size_t candidates);
+    /// Collects (a, b) as a candidate of a full search (repeats allowed).
+    void bulkCandidate(ObjectId a, ObjectId b) { bulkKeys_.push_back(PairStore::keyOf(a, b)); }
+    /// Full search: the store goes to bulk mode and the sorted candidates are merged with
+    /// its sorted pairs in one pass; every candidate gets the exact box test (no
+    /// certificates: when most objects moved, they would cost more than they save), the
+    /// pairs that left drop out, and only the status changes reach Bullet's cache, in the
+    /// order of the pairs' objects.
+    void finishBulkPairs(btDispatcher* dispatcher, std::size_t candidates);
     /// The end of every pair search: filters asked again (EveryFrame; the tested stamp
     /// skips pairs already looked at), erasures, released slots, counters.
     void endSearch(btDispatcher* dispatcher, bool full, std::size_t candidates);
@@ -277,6 +287,14 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// Splits `slack` between the pair's two objects: the triggers at which each must look
     /// at the pair again.
     void share(std::uint32_t at, double slack);
+    /// Leaves the store's bulk mode (no-op outside it): the pairs of an object noted as
+    /// moved (or moved in the search under way) are due at once, the others' once their
+    /// object moves.
+    void indexPairs() {
+        pairs_.index([&](ObjectId id) {
+            return (movedKind_[id] | frameKind_[id]) != 0 ? -HUGE_VAL : travel_[id];
+        });
+    }
     void noteMoved(ObjectId slot, std::uint8_t kind) {
         if (movedKind_[slot] == 0) {
             moved_.push_back(slot);
@@ -337,7 +355,12 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// a setAabb whose travel passes the object's lowest trigger notes it, and only its due
     /// pairs are looked at.
     std::vector<double> travel_;
-    std::vector<std::uint32_t> doomed_;                       ///< scratch: pairs to erase
+    std::vector<std::uint32_t> doomed_;  ///< scratch: pairs to erase
+    /// Scratch of a full search: its candidates' keys, the radix sort's buffer, the merged
+    /// pairs, and the merged pairs whose status change goes through Bullet's cache.
+    std::vector<std::uint64_t> bulkKeys_, bulkScratch_;
+    std::vector<PairStore::Pair> bulkNext_;
+    std::vector<std::uint32_t> bulkChanges_;
     std::vector<std::pair<ObjectId, ObjectId>> coreChanges_;  ///< from a core that tracks
     bool searching_ = false;
     /// > 0 while pair indices must hold (a walk that calls back into Bullet): destroyed
@@ -417,23 +440,24 @@ class CoreBroadphase final : public BroadphaseAdapter {
             core_.findCandidates([&](ObjectId a, ObjectId b) {
                 ++candidates;
                 if (overlaps(fatBoxOf(a), fatBoxOf(b))) {
-                    keepCandidate(a, b);
+                    bulkCandidate(a, b);
                 }
             });
-        } else {
-            // All drops first: they erase pairs, which would move the new pairs' indices.
-            forEachCoreMoved([&](ObjectId moved) { dropLeftCandidates(moved, dispatcher); });
-            forEachCoreMoved([&](ObjectId moved) {
-                const Box& box = fatBoxOf(moved);
-                core_.queryBox(box, [&](ObjectId id) {
-                    ++candidates;
-                    if (id != moved && overlaps(fatBoxOf(id), box)) {
-                        keepCandidate(moved, id);
-                    }
-                });
-            });
+            finishBulkPairs(dispatcher, candidates);
+            return;
         }
-        finishPairs(dispatcher, full, candidates);
+        // All drops first: they erase pairs, which would move the new pairs' indices.
+        forEachCoreMoved([&](ObjectId moved) { dropLeftCandidates(moved, dispatcher); });
+        forEachCoreMoved([&](ObjectId moved) {
+            const Box& box = fatBoxOf(moved);
+            core_.queryBox(box, [&](ObjectId id) {
+                ++candidates;
+                if (id != moved && overlaps(fatBoxOf(id), box)) {
+                    keepCandidate(moved, id);
+                }
+            });
+        });
+        finishPairs(dispatcher, candidates);
     }
 
     void aabbTest(const btVector3& aabbMin, const btVector3& aabbMax,
