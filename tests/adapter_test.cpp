@@ -767,6 +767,56 @@ TEST(Auto, FirstChoiceIsImmediateAndSpreadSizesTakeTheSegmentTrees) {
     }
 }
 
+// Fast motion: a cluster in a large space (the thesis's scene B: 95% of the cubes in a cube
+// of edge 80 inside one of edge 1000) would crowd the dense grid, whose budget of cells per
+// object makes its cells large; the spatial hash keeps small cells there. Spread evenly (scene
+// A), the dense grid fits. The world runs through the broadphase, pairs checked each frame.
+TEST(Auto, FastCrowdedClusterTakesTheSpatialHashAndAnEvenSpreadTheGrid) {
+    for (const bool cluster : {false, true}) {
+        SCOPED_TRACE(cluster ? "cluster" : "even");
+        auto broadphase = makeBroadphase("auto");
+        auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+        std::mt19937 random(13);
+        std::uniform_real_distribution<double> wide(-500, 500), narrow(-40, 40), step(-3, 3);
+        std::vector<btBroadphaseProxy*> proxies;
+        BoxMap boxes;
+        static char client;
+        for (int i = 0; i < 1500; ++i) {
+            const bool inside = cluster && i % 20 != 0;
+            const btVector3 lo(btScalar(inside ? narrow(random) : wide(random)),
+                               btScalar(inside ? narrow(random) : wide(random)),
+                               btScalar(inside ? narrow(random) : wide(random)));
+            ProxyBox box{nullptr, lo, lo + btVector3(2, 2, 2)};
+            box.proxy =
+                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+            boxes[box.proxy] = box;
+        }
+        std::size_t pairsSeen = 0;
+        for (int frame = 0; frame < 4; ++frame) {
+            for (btBroadphaseProxy* proxy : proxies) {  // a box size per frame: fast
+                ProxyBox& box = boxes[proxy];
+                const btVector3 move(btScalar(step(random)), btScalar(step(random)),
+                                     btScalar(step(random)));
+                box.aabbMin += move;
+                box.aabbMax += move;
+                broadphase->setAabb(proxy, box.aabbMin, box.aabbMax, nullptr);
+            }
+            const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+            pairsSeen += pairs.truth.size();
+        }
+        const std::string description = adapter.coreDescription();
+        EXPECT_EQ(description.rfind(cluster ? "auto: spatial-hash" : "auto: grid", 0), 0u)
+            << description;
+        if (cluster) {
+            EXPECT_NE(description.find("crowded"), std::string::npos) << description;
+            EXPECT_GT(pairsSeen, 4u * 50) << "the cluster must have pairs";
+        }
+        adapter.validate();
+    }
+}
+
 // Found by the fuzzer (seed 1, shrunk): "auto" switched to sweep after two searches of an
 // empty world; resetPool then restarted its core on the grid while the adapter still took it
 // for a core that tracks overlaps, and the next pair of overlapping proxies was never found.

@@ -828,7 +828,7 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     measuredChanges_ = measuredMotion_ = measuredRays_ = measuredQueries_ = 0;
     measuredRayLength_ = 0;
     measuredFrames_ = measuredMotionFrames_ = 0;
-    // Sizes and clustering from a sample of at most 1024 live boxes (planes and other
+    // Sizes and centres from a sample of at most 1024 live boxes (planes and other
     // boxes over 1e6 m left out).
     std::vector<double> sizes;
     std::vector<std::array<double, 3>> centres;
@@ -858,34 +858,8 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     const double median = sorted[sorted.size() / 2];
     out.rayLength = median > 0 ? meanRayLength / median : (meanRayLength > 0 ? 1e9 : 0);
     out.sizeSpread = p10 > 0 ? p90 / p10 : (p90 > 0 ? 1e9 : 1);
-    // Clustering: sampled centres per occupied coarse cell (4 median sizes), against what
-    // the same count spread evenly over the centres' bounds would give.
-    std::array<double, 3> lo, hi;
-    lo.fill(HUGE_VAL);
-    hi.fill(-HUGE_VAL);
-    for (const auto& c : centres) {
-        for (int axis = 0; axis < 3; ++axis) {
-            lo[axis] = std::min(lo[axis], c[axis]);
-            hi[axis] = std::max(hi[axis], c[axis]);
-        }
-    }
-    const double cell = std::max(4 * median, 1e-30);
-    double cellsSpanned = 1;
-    for (int axis = 0; axis < 3; ++axis) {
-        cellsSpanned *= std::max(1.0, std::ceil((hi[axis] - lo[axis]) / cell));
-    }
-    std::vector<std::uint64_t> keys;
-    for (const auto& c : centres) {
-        std::uint64_t key = 0;
-        for (int axis = 0; axis < 3; ++axis) {
-            key = key * 2097152 + std::uint64_t(std::min(2097151.0, (c[axis] - lo[axis]) / cell));
-        }
-        keys.push_back(key);
-    }
-    std::sort(keys.begin(), keys.end());
-    const double occupied = double(std::unique(keys.begin(), keys.end()) - keys.begin());
-    const double even = std::min(double(centres.size()), cellsSpanned);
-    out.clustering = even / occupied;
+    out.medianSize = median;
+    out.centres = std::move(centres);
     return out;
 }
 

@@ -3,9 +3,10 @@
 /// AutoCore<D, Scalar>: the core of broadphase "auto". It holds one of kolize's cores at a
 /// time (grid, spatial-hash, segment-trees, sweep) and picks it from what it measures of
 /// the scene (SceneMeasure, filled in by the adapter): object count, how many move and how
-/// far against their size, the spread of sizes, clustering, and the rays and box queries
-/// per frame. When the scene changes it switches: the adapter rebuilds the new core from the
-/// current boxes without touching the pair cache (no pair lost, no cached algorithm freed).
+/// far against their size, the spread of sizes, how crowded the cells would be, and the rays and
+/// box queries per frame. When the scene changes it switches: the adapter rebuilds the new core
+/// from the current boxes without touching the pair cache (no pair lost, no cached algorithm
+/// freed).
 ///
 /// The rules (measured with kolize-demo over the scene registry, see README):
 /// - sizes spread over more than 30x (90th over 10th percentile): segment-trees, whose cost
@@ -19,7 +20,12 @@
 ///   3.09 and 3.48);
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
 ///   most Bullet worlds, resting or settling): sweep;
-/// - faster motion, objects clustered: segment-trees;
+/// - faster motion, and the dense grid would crowd (its cells, enlarged to fit its budget of
+///   cells per object over the objects' bounds, would put more than 4 + 2x as many other
+///   objects beside an object as the sparse cells do: a cluster in a large space, as the
+///   thesis's scene B): spatial-hash, whose cells keep their size wherever the objects are
+///   (thesis B fast, 3000 objects: spatial-hash 0.25x of dbvt, segment-trees 0.32x, grid
+///   1.4x, kolize-bench);
 /// - faster motion otherwise: grid.
 /// The first evaluation (after two pair searches) switches at once: the starting core
 /// (grid) was nobody's choice. After that a choice must win two evaluations in a row
@@ -31,8 +37,13 @@
 #include <kolize/broadphase/segment_tree_set.h>
 #include <kolize/broadphase/sweep_and_prune.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
+#include <vector>
 
 namespace kolize {
 
@@ -43,7 +54,9 @@ struct SceneMeasure {
     double movedPerFrame = 0;   ///< objects whose box changed, per frame
     double relativeMotion = 0;  ///< mean over those moves of motion / box size
     double sizeSpread = 1;      ///< 90th over 10th percentile of box sizes (sampled)
-    double clustering = 1;      ///< objects per occupied coarse cell over the uniform figure
+    double medianSize = 0;      ///< median largest extent of the sampled boxes
+    /// Centres of a sample of the boxes (at most 1024, planes and boxes over 1e6 left out).
+    std::vector<std::array<double, 3>> centres;
     double raysPerFrame = 0;
     double rayLength = 0;  ///< mean reach of the rays, in median box sizes (sampled sizes)
     double boxQueriesPerFrame = 0;
@@ -196,14 +209,75 @@ class AutoCore {
                           " of their size): sorted endpoints move few places";
             return Kind::Sweep;
         }
-        if (m.clustering > 8) {
-            ruleReason_ = "fast motion with clustering " + shortNumber(m.clustering) +
-                          ": segment trees do not depend on one cell size";
-            return Kind::SegmentTrees;
+        const double sparse = sparseCell(m), dense = denseCell(m, sparse);
+        const double crowdSparse = crowding(m, sparse), crowdDense = crowding(m, dense);
+        if (crowdDense > 4 + 2 * crowdSparse) {
+            ruleReason_ = "fast motion, crowded: the dense grid's cells (" + shortNumber(dense) +
+                          ") would put " + shortNumber(crowdDense) +
+                          " others beside an object, the sparse cells (" + shortNumber(sparse) +
+                          ") " + shortNumber(crowdSparse);
+            return Kind::SpatialHash;
         }
         ruleReason_ = "fast motion (" + shortNumber(m.relativeMotion) +
                       " of their size per frame), even sizes, spread out: one cell size fits";
         return Kind::Grid;
+    }
+
+    /// The cell edge of the sparse cores (spatial-hash), as CellGridSettings sizes it.
+    double sparseCell(const SceneMeasure& m) const {
+        return settings_.cells.cellSize > 0 ? settings_.cells.cellSize
+                                            : settings_.cells.sizeFactor * m.medianSize;
+    }
+    /// The dense grid's cell edge: the sparse one, enlarged so that the sampled centres'
+    /// bounds need at most its budget of cells.
+    double denseCell(const SceneMeasure& m, double sparse) const {
+        if (settings_.cells.cellSize > 0 || m.centres.empty() || !(sparse > 0)) {
+            return sparse;
+        }
+        double volume = 1;
+        for (int axis = 0; axis < 3; ++axis) {
+            double lo = HUGE_VAL, hi = -HUGE_VAL;
+            for (const auto& c : m.centres) {
+                lo = std::min(lo, c[axis]);
+                hi = std::max(hi, c[axis]);
+            }
+            volume *= std::max(hi - lo, sparse);
+        }
+        const double cells = std::max(1.0, std::min(settings_.cells.cellsPerObject *
+                                                        double(std::max<std::size_t>(m.objects, 1)),
+                                                    settings_.cells.maxCells));
+        return std::max(sparse, std::cbrt(volume / cells));
+    }
+    /// Expected number of other objects whose centre shares an object's cell of edge `cell`,
+    /// from the sampled centres, scaled to all objects.
+    static double crowding(const SceneMeasure& m, double cell) {
+        const std::size_t samples = m.centres.size();
+        if (samples < 2 || !(cell > 0)) {
+            return 0;
+        }
+        std::vector<std::array<long long, 3>> keys;
+        keys.reserve(samples);
+        for (const auto& c : m.centres) {
+            std::array<long long, 3> key;
+            for (int axis = 0; axis < 3; ++axis) {
+                key[axis] =
+                    static_cast<long long>(std::floor(std::clamp(c[axis] / cell, -1e15, 1e15)));
+            }
+            keys.push_back(key);
+        }
+        std::sort(keys.begin(), keys.end());
+        double sharing = 0;  // ordered pairs of sampled centres in one cell
+        for (std::size_t at = 0; at < samples;) {
+            std::size_t end = at;
+            while (end < samples && keys[end] == keys[at]) {
+                ++end;
+            }
+            const double run = double(end - at);
+            sharing += run * (run - 1);
+            at = end;
+        }
+        const double n = double(std::max(m.objects, samples));
+        return sharing / double(samples) * (n - 1) / double(samples - 1);
     }
 
     static std::string shortNumber(double x) {
