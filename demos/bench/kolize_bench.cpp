@@ -68,6 +68,10 @@ const char* kUsage =
     "                           1500,2000,5000)\n"
     "  --seed S                 scene seed (default 1)\n"
     "  --csv FILE               also write one row per run\n"
+    "  --cache-share on|off     kolize broadphases: run each once more into a pair cache\n"
+    "                           that only counts, and print the share of the frame spent\n"
+    "                           in Bullet's pair cache (hashing, filters, pair records)\n"
+    "                           and the pairs added and removed per frame (default off)\n"
     "  --help                   this text\n"
     "brute-force and simple are skipped above N = 20000 (O(N^2) per frame); sap and\n"
     "sap-noray above 32766 objects (btAxisSweep3's 16-bit handles); sap32 above 50000\n"
@@ -83,6 +87,7 @@ struct Options {
     std::uint32_t seed = 1;
     std::string csv;
     std::vector<int> sweep;  ///< S values of --s-sweep, empty without it
+    bool cacheShare = false;
 };
 
 [[noreturn]] void fail(const std::string& message) {
@@ -223,6 +228,11 @@ Options parse(int argc, char** argv) {
             options.seed = static_cast<std::uint32_t>(number("--seed", value));
         } else if (flag == "--csv") {
             options.csv = value;
+        } else if (flag == "--cache-share") {
+            if (value != "on" && value != "off") {
+                fail("--cache-share takes on or off, got '" + value + "'");
+            }
+            options.cacheShare = value == "on";
         } else {
             fail("unknown option '" + flag + "'");
         }
@@ -258,6 +268,28 @@ struct Row {
     std::size_t extra = 0;
     std::size_t candidates = 0;  ///< kolize broadphases: candidates in the last frame
     std::size_t peakBytes = 0;
+    /// --cache-share, the run with CountingPairCache: pairs added and removed per frame.
+    double addedPerFrame = 0, removedPerFrame = 0;
+};
+
+/// A pair cache that only counts: what a broadphase's frame costs without Bullet's pair
+/// cache (its hashing, the filters it asks, the pair records). For --cache-share.
+class CountingPairCache : public btHashedOverlappingPairCache {
+  public:
+    btBroadphasePair* addOverlappingPair(btBroadphaseProxy*, btBroadphaseProxy*) override {
+        ++count;
+        ++added;
+        return &dummy;
+    }
+    void* removeOverlappingPair(btBroadphaseProxy*, btBroadphaseProxy*, btDispatcher*) override {
+        --count;
+        ++removed;
+        return nullptr;
+    }
+    int getNumOverlappingPairs() const override { return count; }
+    btBroadphasePair dummy;
+    int count = 0;
+    std::size_t added = 0, removed = 0;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -269,7 +301,9 @@ btVector3 vec(const std::array<double, 3>& v) {
     return btVector3(btScalar(v[0]), btScalar(v[1]), btScalar(v[2]));
 }
 
-Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, int frames) {
+/// One broadphase on one scene. `counting`: into a CountingPairCache (no error check).
+Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, int frames,
+        bool counting = false) {
     Row row;
     row.label = entry.label;
     const int n = sceneSettings.objects;
@@ -285,6 +319,10 @@ Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, in
     settings.worldMin = btVector3(-bound, -bound, -bound);
     settings.worldMax = btVector3(bound, bound, bound);
     settings.maxProxies = std::max(n + 2, 2);
+    CountingPairCache countingCache;
+    if (counting) {
+        settings.pairCache = &countingCache;
+    }
     kolize::bench::resetPeak();
     std::unique_ptr<btBroadphaseInterface> broadphase =
         kolize::makeMeasuredBroadphase(entry.name, settings);
@@ -299,6 +337,7 @@ Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, in
     broadphase->calculateOverlappingPairs(&dispatcher);
     row.initMs = msSince(initStart);
     std::vector<double> frameMs;
+    const std::size_t addedBefore = countingCache.added, removedBefore = countingCache.removed;
     for (int frame = 0; frame < frames; ++frame) {
         scene.step();
         const Clock::time_point start = Clock::now();
@@ -312,6 +351,15 @@ Row run(const Entry& entry, const kolize::ThesisSceneSettings& sceneSettings, in
     }
     row.frameMs = median(frameMs);
     row.peakBytes = kolize::bench::peakBytesSinceReset();
+    if (counting) {
+        row.addedPerFrame = double(countingCache.added - addedBefore) / std::max(frames, 1);
+        row.removedPerFrame = double(countingCache.removed - removedBefore) / std::max(frames, 1);
+        for (btBroadphaseProxy* proxy : proxies) {
+            broadphase->destroyProxy(proxy, &dispatcher);
+        }
+        broadphase.reset();  // before its pair cache
+        return row;
+    }
     // Errors of the last frame against the exact truth.
     std::vector<kolize::ProxyBox> boxes;
     boxes.reserve(proxies.size());
@@ -549,6 +597,22 @@ int main(int argc, char** argv) {
                         }
                         std::fprintf(csv, "\n");
                     }
+                }
+                for (std::size_t at = 0; options.cacheShare && at < rows.size(); ++at) {
+                    const Row& row = rows[at];
+                    if (!row.skipped.empty() || !kolize::isExactBroadphase(entries[at].name)) {
+                        continue;
+                    }
+                    progress(entries[at].label + " with a counting pair cache");
+                    const Row bare = run(entries[at], sceneSettings, frames, true);
+                    progress("");
+                    std::printf(
+                        "pair cache share, %s: %.4f ms per frame, %.4f with a pair cache that "
+                        "only counts: Bullet's pair cache %.4f ms (%.0f%%); %.0f pairs added and "
+                        "%.0f removed per frame\n",
+                        row.label.c_str(), row.frameMs, bare.frameMs, row.frameMs - bare.frameMs,
+                        row.frameMs > 0 ? 100 * (row.frameMs - bare.frameMs) / row.frameMs : 0.0,
+                        bare.addedPerFrame, bare.removedPerFrame);
                 }
                 std::fflush(stdout);
             }
