@@ -83,12 +83,12 @@ void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
         getPairCache()->findPair(a->getBroadphaseHandle(), b->getBroadphaseHandle());
     btCollisionAlgorithm* algorithm = pair ? pair->m_algorithm : nullptr;
     bool temporary = false;
-    if (pair) {
+    if (algorithm) {
         a = static_cast<btCollisionObject*>(pair->m_pProxy0->m_clientObject);
         b = static_cast<btCollisionObject*>(pair->m_pProxy1->m_clientObject);
     } else {
-        // Not in the pair cache (their boxes before the solver did not meet): an algorithm
-        // for the question, which saw no contacts at the start.
+        // Not dispatched this step (their boxes before the solver did not meet): an
+        // algorithm for the question, which saw no contacts at the start.
         const btCollisionObjectWrapper wrapA(nullptr, a->getCollisionShape(), a,
                                              a->getWorldTransform(), -1, -1);
         const btCollisionObjectWrapper wrapB(nullptr, b->getCollisionShape(), b,

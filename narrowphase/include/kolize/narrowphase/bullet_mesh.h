@@ -1,9 +1,10 @@
 #pragma once
 /// \file
 /// The narrowphase inside Bullet: a mesh shape over a narrowphase MeshModel, the collision
-/// algorithms that give it exact contacts, and their registration on a dispatcher. This is
-/// the narrowphase's only Bullet adapter (header and source): everything below it
-/// (mesh_model.h, mesh_query.h, triangle_test.h) knows nothing of Bullet.
+/// algorithms that give it exact contacts and times of impact, and their registration on a
+/// dispatcher. With bullet_mesh_world.h (the CCD world, which adds BulletDynamics) this is
+/// the narrowphase's only Bullet adapter: everything below it (mesh_model.h, mesh_query.h,
+/// triangle_test.h, mesh_ccd.h) knows nothing of Bullet.
 ///
 /// Use:
 /// \code
