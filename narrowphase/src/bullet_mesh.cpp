@@ -785,7 +785,7 @@ btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
         const btScalar toi =
             std::clamp(roundOutward(f0 + hit.toi * (f1 - f0), false), btScalar(0), btScalar(1));
         for (btCollisionObject* body : {body0, body1}) {
-            if (body->getHitFraction() > toi) {
+            if (movesOverStep(*body) && body->getHitFraction() > toi) {
                 body->setHitFraction(toi);
             }
         }

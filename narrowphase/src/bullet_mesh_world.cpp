@@ -103,8 +103,9 @@ void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
         const btScalar toi = mesh->calculateTimeOfImpact(a, b, getDispatchInfo(), nullptr);
         if (toi < 1) {
             for (btCollisionObject* object : {a, b}) {
+                const double length = motionLength(*object);
                 const double fraction =
-                    std::min(1.0, double(toi) + settings_.penetration / motionLength(*object));
+                    length > 0 ? std::min(1.0, double(toi) + settings_.penetration / length) : 1.0;
                 auto [it, inserted] = allowed_.emplace(object, fraction);
                 if (!inserted) {
                     it->second = std::min(it->second, fraction);
@@ -173,6 +174,9 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
             }
             const auto allowed = allowed_.find(body);
             const double fraction = allowed == allowed_.end() ? 1.0 : allowed->second;
+            if (fraction >= 1) {
+                continue;  // the whole step: Bullet's integrator moves it there
+            }
             btTransform clamped;
             body->predictIntegratedTransform(timeStep * btScalar(fraction), clamped);
             clamped_.push_back({body, clamped, hit});

@@ -186,9 +186,9 @@ bool exceedsCcdMotionThreshold(const btCollisionObject& object);
 ///   itself into the other, is still stopped;
 /// - a transform, or a vertex moved by it, is not finite;
 /// - the meshes do not touch during the step.
-/// Like Bullet's algorithms, a time of impact below a body's hit fraction lowers it
-/// (setHitFraction); nothing else changes. `info` and `resultOut` are not used (null is
-/// fine). Cost: O(vertices) to move both meshes, then meshCcd's (its time slices and
+/// Like Bullet's algorithms, a time of impact below the hit fraction of a body that moves over
+/// the step lowers it (setHitFraction); nothing else changes. `info` and `resultOut` are not used
+/// (null is fine). Cost: O(vertices) to move both meshes, then meshCcd's (its time slices and
 /// per-feature hierarchies).
 class MeshContactAlgorithm : public btActivatingCollisionAlgorithm {
   public:

@@ -70,7 +70,7 @@ struct MeshCcdCounters {
 ///    it goes `penetration` past the first contact (settings);
 /// 4. btDiscreteDynamicsWorld::integrateTransforms runs as usual (Bullet's swept sphere for
 ///    convex bodies, unchanged);
-/// 5. every body limited in 3 is then put where Bullet's own CCD would put it, its
+/// 5. every body limited in 3 to h' < 1 is then put where Bullet's own CCD would put it, its
 ///    predictIntegratedTransform over h' times the step, via proceedToTransform. Its
 ///    velocity is kept: the collision response happens in the next step, from the contact
 ///    made there (as in Bullet's integrateTransforms). Its getHitFraction() holds the
