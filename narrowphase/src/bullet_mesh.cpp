@@ -1,5 +1,7 @@
 #include "kolize/narrowphase/bullet_mesh.h"
 
+#include "kolize/narrowphase/mesh_ccd.h"
+
 #include <BulletCollision/CollisionDispatch/btCollisionConfiguration.h>
 #include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
 #include <LinearMath/btPoolAllocator.h>
@@ -610,10 +612,187 @@ void MeshShape::setLocalScaling(const btVector3& scaling) {
 // ---------------------------------------------------------------------------------------
 // MeshMeshAlgorithm
 
+/// A mesh's step for the time of impact: its vertices (model frame) and its poses at the
+/// start and at the end of the step.
+struct MeshStep {
+    const std::vector<Vec3>* vertices = nullptr;
+    Pose start, end;
+};
+
 struct MeshContactAlgorithm::State {
     narrowphase::MeshQuery query;
     std::vector<MeshContact> contacts;
+    MeshStep stepA, stepB;              ///< filled by calculateTimeOfImpact
+    std::vector<Vec3> sceneryVertices;  ///< scenery triangles' vertices (world)
+    ccd::MovingMesh movingA, movingB;   ///< the meshCcd input (buffers reused)
 };
+
+namespace {
+
+/// Moves over the step in the time of impact's sense (bullet_mesh.h).
+bool movesOverStep(const btCollisionObject& object) {
+    return object.getInternalType() == btCollisionObject::CO_RIGID_BODY && object.isActive() &&
+           !object.isStaticOrKinematicObject();
+}
+
+const btTransform& endOfStep(const btCollisionObject& object) {
+    return movesOverStep(object) ? object.getInterpolationWorldTransform()
+                                 : object.getWorldTransform();
+}
+
+/// Turns of more than this (radians) over the step are cut into pieces of at most this
+/// turn, each a chord: a vertex at distance r from the axis leaves its arc by at most
+/// r (1 - cos(kMaxTurn / 2)), about 1.2e-3 r.
+constexpr double kMaxTurn = 0.1;
+/// Bullet's integrator turns a body by at most pi/4 per step (ANGULAR_MOTION_THRESHOLD),
+/// which is 8 pieces; other ends of a step (a user's transforms) are cut into at most 64.
+constexpr int kMaxPieces = 64;
+
+/// The pose at `f` of the step from `start` to `end`: the translation on the segment, the
+/// rotation at constant angular velocity (slerp), as Bullet's integrator moves a body.
+Pose poseAt(const Pose& start, const Pose& end, double f) {
+    if (f <= 0) {
+        return start;
+    }
+    if (f >= 1) {
+        return end;
+    }
+    Pose pose;
+    pose.translation = start.translation + f * (end.translation - start.translation);
+    const Eigen::Quaterniond q0(start.rotation), q1(end.rotation);
+    pose.rotation = q0.slerp(f, q1).normalized().toRotationMatrix();
+    return pose;
+}
+
+double turnOf(const MeshStep& step) {
+    return Eigen::Quaterniond(step.start.rotation)
+        .angularDistance(Eigen::Quaterniond(step.end.rotation));
+}
+
+/// The step's vertices at fractions f0 and f1 (world frame) into `out`. False when one is
+/// not finite (meshCcd refuses those).
+bool place(const MeshStep& step, double f0, double f1, ccd::MovingMesh& out) {
+    const Pose p0 = poseAt(step.start, step.end, f0);
+    const Pose p1 = poseAt(step.start, step.end, f1);
+    const std::vector<Vec3>& vertices = *step.vertices;
+    out.start.resize(vertices.size());
+    out.end.resize(vertices.size());
+    bool finite = true;
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        out.start[i] = p0.rotation * vertices[i] + p0.translation;
+        out.end[i] = p1.rotation * vertices[i] + p1.translation;
+        finite = finite && out.start[i].allFinite() && out.end[i].allFinite();
+    }
+    return finite;
+}
+
+void setTriangles(const std::vector<Index3>& triangles, ccd::MovingMesh& out) {
+    out.triangles.assign(triangles.begin(), triangles.end());
+}
+
+/// The step of `object` with `vertices`; false for a non-finite transform.
+bool stepOf(const btCollisionObject& object, const std::vector<Vec3>& vertices, MeshStep& out) {
+    if (!finitePose(object.getWorldTransform()) || !finitePose(endOfStep(object))) {
+        return false;
+    }
+    out.vertices = &vertices;
+    out.start = toPose(object.getWorldTransform());
+    out.end = toPose(endOfStep(object));
+    return true;
+}
+
+/// The box (scenery frame) around `shape` at the start and at the end of `mesh`'s step.
+void sweptBoxIn(const MeshShape& shape, const btCollisionObject& mesh, const btTransform& scenery,
+                btVector3& lo, btVector3& hi) {
+    const btTransform inverse = scenery.inverse();
+    shape.getAabb(inverse * mesh.getWorldTransform(), lo, hi);
+    btVector3 endLo, endHi;
+    shape.getAabb(inverse * endOfStep(mesh), endLo, endHi);
+    lo.setMin(endLo);
+    hi.setMax(endHi);
+}
+
+/// The smallest CCD motion threshold of the bodies in the pair that exceed theirs.
+double ccdThresholdOfPair(const btCollisionObject& a, const btCollisionObject& b) {
+    double threshold = std::numeric_limits<double>::infinity();
+    for (const btCollisionObject* body : {&a, &b}) {
+        if (exceedsCcdMotionThreshold(*body)) {
+            threshold = std::min(threshold, std::sqrt(double(body->getCcdSquareMotionThreshold())));
+        }
+    }
+    return threshold;
+}
+
+/// Whether some vertex of `a` moves towards `b` along the normal of one of `contacts` (from
+/// a towards b), relative to b, by more than `limit` over the step.
+bool drivesIn(const std::vector<MeshContact>& contacts, const ccd::MovingMesh& a,
+              const ccd::MovingMesh& b, double limit) {
+    for (const MeshContact& contact : contacts) {
+        double forwardA = -std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < a.start.size(); ++i) {
+            forwardA = std::max(forwardA, (a.end[i] - a.start[i]).dot(contact.normal));
+        }
+        double forwardB = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < b.start.size(); ++i) {
+            forwardB = std::min(forwardB, (b.end[i] - b.start[i]).dot(contact.normal));
+        }
+        if (forwardA - forwardB > limit) {
+            return true;
+        }
+    }
+    return false;
+}
+
+}  // namespace
+
+bool exceedsCcdMotionThreshold(const btCollisionObject& object) {
+    if (!movesOverStep(object)) {
+        return false;
+    }
+    const btScalar threshold = object.getCcdSquareMotionThreshold();
+    const btScalar motion = (object.getInterpolationWorldTransform().getOrigin() -
+                             object.getWorldTransform().getOrigin())
+                                .length2();
+    return threshold > 0 && threshold < motion;
+}
+
+btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
+                                                  btCollisionObject* body1) {
+    State& s = *state_;
+    if (!place(s.stepA, 0, 1, s.movingA) || !place(s.stepB, 0, 1, s.movingB)) {
+        return btScalar(1);
+    }
+    // In contact at the start: the contacts hold the pair unless a vertex drives in along
+    // their normals by more than a CCD threshold (a body turning about its contact sweeps
+    // the rest of itself into, and through, the other; sliding or leaving does not).
+    if (!s.contacts.empty() &&
+        !drivesIn(s.contacts, s.movingA, s.movingB, ccdThresholdOfPair(*body0, *body1))) {
+        return btScalar(1);
+    }
+    const double turn = std::max(turnOf(s.stepA), turnOf(s.stepB));
+    const int pieces = std::clamp(int(std::ceil(turn / kMaxTurn)), 1, kMaxPieces);
+    for (int k = 0; k < pieces; ++k) {
+        const double f0 = double(k) / pieces, f1 = double(k + 1) / pieces;
+        if (pieces > 1 &&
+            (!place(s.stepA, f0, f1, s.movingA) || !place(s.stepB, f0, f1, s.movingB))) {
+            return btScalar(1);
+        }
+        const ccd::MeshContact hit = ccd::meshCcd(s.movingA, s.movingB);
+        if (!hit.hit) {
+            continue;
+        }
+        // Rounded down: the fraction handed to Bullet stays no later than the contact.
+        const btScalar toi =
+            std::clamp(roundOutward(f0 + hit.toi * (f1 - f0), false), btScalar(0), btScalar(1));
+        for (btCollisionObject* body : {body0, body1}) {
+            if (movesOverStep(*body) && body->getHitFraction() > toi) {
+                body->setHitFraction(toi);
+            }
+        }
+        return toi;
+    }
+    return btScalar(1);
+}
 
 MeshContactAlgorithm::MeshContactAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
                                            const btCollisionObjectWrapper* body0,
@@ -636,11 +815,6 @@ MeshContactAlgorithm::~MeshContactAlgorithm() {
 
 const std::vector<MeshContact>& MeshContactAlgorithm::lastContacts() const {
     return state_->contacts;
-}
-
-btScalar MeshContactAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
-                                                     const btDispatcherInfo&, btManifoldResult*) {
-    return btScalar(1);
 }
 
 void MeshContactAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
@@ -677,6 +851,25 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     if (ownManifold_) {
         resultOut->refreshContactPoints();
     }
+}
+
+btScalar MeshMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
+                                                  btCollisionObject* body1, const btDispatcherInfo&,
+                                                  btManifoldResult*) {
+    if (!exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1)) {
+        return btScalar(1);
+    }
+    const TriangleMesh& meshA =
+        static_cast<const MeshShape*>(body0->getCollisionShape())->model().mesh();
+    const TriangleMesh& meshB =
+        static_cast<const MeshShape*>(body1->getCollisionShape())->model().mesh();
+    if (!stepOf(*body0, meshA.vertices(), state_->stepA) ||
+        !stepOf(*body1, meshB.vertices(), state_->stepB)) {
+        return btScalar(1);
+    }
+    setTriangles(meshA.triangles(), state_->movingA);
+    setTriangles(meshB.triangles(), state_->movingB);
+    return reportTimeOfImpact(body0, body1);
 }
 
 btCollisionAlgorithm* MeshMeshAlgorithm::CreateFunc::CreateCollisionAlgorithm(
@@ -822,6 +1015,41 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     if (ownManifold_) {
         resultOut->refreshContactPoints();
     }
+}
+
+btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
+                                                 const btDispatcherInfo&, btManifoldResult*) {
+    if (!exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1)) {
+        return btScalar(1);
+    }
+    btCollisionObject* meshObject = meshFirst_ ? body0 : body1;
+    btCollisionObject* sceneryObject = meshFirst_ ? body1 : body0;
+    const auto* shape = static_cast<const MeshShape*>(meshObject->getCollisionShape());
+    const auto* scenery = static_cast<const btConcaveShape*>(sceneryObject->getCollisionShape());
+    const btTransform& sceneryPose = sceneryObject->getWorldTransform();
+    if (!finitePose(meshObject->getWorldTransform()) || !finitePose(endOfStep(*meshObject)) ||
+        !finitePose(sceneryPose)) {
+        return btScalar(1);
+    }
+    btVector3 lo, hi;
+    sweptBoxIn(*shape, *meshObject, sceneryPose, lo, hi);
+    SceneryCollector collector(toPose(sceneryPose));
+    scenery->processAllTriangles(&collector, lo, hi);
+    if (collector.triangles.empty()) {
+        return btScalar(1);
+    }
+    const TriangleMesh& mesh = shape->model().mesh();
+    if (!stepOf(*meshObject, mesh.vertices(), state_->stepA)) {
+        return btScalar(1);
+    }
+    setTriangles(mesh.triangles(), state_->movingA);
+    // The scenery's triangles are already in the world, where they stay.
+    state_->sceneryVertices = std::move(collector.vertices);
+    state_->stepB.vertices = &state_->sceneryVertices;
+    state_->stepB.start = Pose();
+    state_->stepB.end = Pose();
+    setTriangles(collector.triangles, state_->movingB);
+    return reportTimeOfImpact(body0, body1);
 }
 
 btCollisionAlgorithm* BvhMeshAlgorithm::CreateFunc::CreateCollisionAlgorithm(

@@ -1,9 +1,10 @@
 #pragma once
 /// \file
 /// The narrowphase inside Bullet: a mesh shape over a narrowphase MeshModel, the collision
-/// algorithms that give it exact contacts, and their registration on a dispatcher. This is
-/// the narrowphase's only Bullet adapter (header and source): everything below it
-/// (mesh_model.h, mesh_query.h, triangle_test.h) knows nothing of Bullet.
+/// algorithms that give it exact contacts and times of impact, and their registration on a
+/// dispatcher. With bullet_mesh_world.h (the CCD world, which adds BulletDynamics) this is
+/// the narrowphase's only Bullet adapter: everything below it (mesh_model.h, mesh_query.h,
+/// triangle_test.h, mesh_ccd.h) knows nothing of Bullet.
 ///
 /// Use:
 /// \code
@@ -35,6 +36,11 @@
 /// that moved apart, as for its own algorithms. A body at rest is mostly held by these kept
 /// points (the solver leaves it touching or a hair apart, where the exact test finds no
 /// new pair); contactTest/contactPairTest then report nothing until the meshes touch.
+///
+/// Continuous collision: the mesh algorithms' calculateTimeOfImpact is the exact first
+/// contact of the two moving meshes (kolize::ccd::meshCcd; see MeshContactAlgorithm), and
+/// kolize::MeshCcdWorld (bullet_mesh_world.h) is the world that calls it and stops fast mesh
+/// bodies there; a plain btDiscreteDynamicsWorld gives MeshShape bodies no CCD at all.
 ///
 /// Convex shapes against a MeshShape: the mesh's tree is queried with the convex's box, then
 /// Bullet's own convex-triangle algorithms (GJK/EPA per triangle, btConvexTriangleCallback)
@@ -146,22 +152,56 @@ struct MeshContact {
     std::int32_t partX = 0, triangleX = -1, partY = 0, triangleY = -1;
 };
 
+/// Whether Bullet's integrator would run CCD for `object` this step: an active rigid body,
+/// neither static nor kinematic, with a motion threshold (setCcdMotionThreshold > 0) that
+/// the motion of its origin from its world to its interpolation transform exceeds (Bullet's
+/// integrateTransforms rule, `threshold^2 < motion^2`).
+bool exceedsCcdMotionThreshold(const btCollisionObject& object);
+
 /// What the two exact mesh algorithms share: the manifold (the dispatcher's, or one of its
-/// own), the mesh query and the last contacts (off Bullet's fixed-size algorithm pool), no
-/// time of impact yet.
+/// own), the mesh query, the last contacts and the moving meshes of the time of impact (off
+/// Bullet's fixed-size algorithm pool).
+///
+/// Time of impact (calculateTimeOfImpact, Bullet's continuous entry point, which Bullet
+/// 3.24's btDiscreteDynamicsWorld never calls: see bullet_mesh_world.h for the world that
+/// does). The step is Bullet's: each body moves from its world transform (the start of the
+/// step) to its interpolation transform (where the integrator will put it), as Bullet's own
+/// convex algorithms read them; a static or kinematic body, or one that is not active,
+/// stays at its world transform. Between the two, a body translates on the segment and
+/// turns at constant angular velocity (slerp), as Bullet's integrator moves it. The step is
+/// cut into pieces of at most 0.1 rad of turn (at most 64; Bullet's integrator turns a body
+/// by at most pi/4 per step, 8 pieces), in each of which every vertex moves on its chord, and
+/// kolize::ccd::meshCcd finds the earliest vertex-face or edge-edge contact of the chords,
+/// piece by piece. For a translating body (one piece) that is the exact first contact, never
+/// late and at most 1e-6 of the step early; for a turning one it is the chords' (a vertex at
+/// distance r from the axis is within 1.2e-3 r of its arc; the thesis used one chord per
+/// step). The result is that time as a fraction of the step, rounded down to btScalar, or 1
+/// when:
+/// - neither body exceedsCcdMotionThreshold (a slow pair keeps 1, and costs nothing);
+/// - the pair touched at the start of the step (the last processCollision, which Bullet runs
+///   for the same step before any time of impact, made contacts) and no vertex moves, relative
+///   to the other body, by more than the smaller CCD motion threshold of the fast bodies
+///   along one of those contacts' normals: sliding along or leaving a contact is the
+///   contacts' business, while a body that turns about its contact, sweeping the rest of
+///   itself into the other, is still stopped;
+/// - a transform, or a vertex moved by it, is not finite;
+/// - the meshes do not touch during the step.
+/// Like Bullet's algorithms, a time of impact below the hit fraction of a body that moves over
+/// the step lowers it (setHitFraction); nothing else changes. `info` and `resultOut` are not used
+/// (null is fine). Cost: O(vertices) to move both meshes, then meshCcd's (its time slices and
+/// per-feature hierarchies).
 class MeshContactAlgorithm : public btActivatingCollisionAlgorithm {
   public:
     ~MeshContactAlgorithm() override;
-    /// 1 (no time of impact yet: continuous collision is a later stage).
-    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
-                                   const btDispatcherInfo& info,
-                                   btManifoldResult* resultOut) override;
     void getAllContactManifolds(btManifoldArray& manifolds) override;
     /// The contacts made by the last processCollision (world frame; X = body0 for two meshes,
     /// the MeshShape against scenery).
     const std::vector<MeshContact>& lastContacts() const;
 
   protected:
+    /// meshCcd over the moving meshes the caller filled in (State), reported as the class
+    /// comment says for the bodies `body0`, `body1`.
+    btScalar reportTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1);
     MeshContactAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
                          const btCollisionObjectWrapper* body0,
                          const btCollisionObjectWrapper* body1);
@@ -171,7 +211,8 @@ class MeshContactAlgorithm : public btActivatingCollisionAlgorithm {
     std::unique_ptr<State> state_;
 };
 
-/// MeshShape against MeshShape: the exact mesh query, contacts from its triangle pairs.
+/// MeshShape against MeshShape: the exact mesh query, contacts from its triangle pairs; the
+/// time of impact of the two whole meshes (MeshContactAlgorithm).
 class MeshMeshAlgorithm : public MeshContactAlgorithm {
   public:
     MeshMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -179,6 +220,10 @@ class MeshMeshAlgorithm : public MeshContactAlgorithm {
     void processCollision(const btCollisionObjectWrapper* body0,
                           const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
                           btManifoldResult* resultOut) override;
+    /// See MeshContactAlgorithm. body0 and body1 in the algorithm's order (the pair's).
+    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
+                                   const btDispatcherInfo& info,
+                                   btManifoldResult* resultOut) override;
 
     struct CreateFunc : btCollisionAlgorithmCreateFunc {
         btCollisionAlgorithm* CreateCollisionAlgorithm(
@@ -189,6 +234,9 @@ class MeshMeshAlgorithm : public MeshContactAlgorithm {
 
 /// A convex shape against a MeshShape (either order): the tree gives the triangles in the
 /// convex's box, Bullet's convex-triangle algorithm the contacts. Never the SDF path.
+/// Time of impact: 1. A fast convex body gets Bullet's own CCD (its swept sphere in
+/// btDiscreteDynamicsWorld::integrateTransforms sweeps through MeshShape's
+/// processAllTriangles); a fast mesh body against a convex one has none yet.
 class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
   public:
     ConvexMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -225,6 +273,9 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 /// narrowphase mesh in world coordinates (vertices welded where exactly equal, rebuilt each
 /// call: O(k log k) for k triangles), queried exactly against the mesh. Contacts as for two
 /// meshes, the scenery's part and triangle index on each point.
+/// Time of impact (MeshContactAlgorithm): the mesh against the scenery's triangles in the
+/// box around the mesh at the start and at the end of the step (scenery frame); the scenery
+/// stays at its world transform (Bullet's triangle-mesh scenery is static).
 class BvhMeshAlgorithm : public MeshContactAlgorithm {
   public:
     BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -233,6 +284,10 @@ class BvhMeshAlgorithm : public MeshContactAlgorithm {
     void processCollision(const btCollisionObjectWrapper* body0,
                           const btCollisionObjectWrapper* body1, const btDispatcherInfo& info,
                           btManifoldResult* resultOut) override;
+    /// See MeshContactAlgorithm. body0 and body1 in the algorithm's order (the pair's).
+    btScalar calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
+                                   const btDispatcherInfo& info,
+                                   btManifoldResult* resultOut) override;
 
     struct CreateFunc : btCollisionAlgorithmCreateFunc {
         btCollisionAlgorithm* CreateCollisionAlgorithm(
