@@ -156,6 +156,7 @@ const std::vector<SceneEntry>& sceneEntries() {
         boxes("boxes-plane",
               "the same 3000 boxes falling onto a static plane (its AABB is +-1e18)");
         addWorldScenes(list);
+        addMeshBodyScenes(list);
         addBulletBenchmarkScenes(list);
         return list;
     }();

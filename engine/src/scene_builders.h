@@ -5,8 +5,11 @@
 
 #include <kolize/engine/scene.h>
 
+#include <functional>
 #include <memory>
 #include <vector>
+
+class btRigidBody;
 
 namespace kolize {
 
@@ -25,6 +28,22 @@ const std::vector<SceneEntry>& sceneEntries();
 /// Appends the world scenes of world_scenes.cpp (Bullet-benchmark worlds, meshes, extreme
 /// and stiff cases).
 void addWorldScenes(std::vector<SceneEntry>& entries);
+
+class WorldScene;
+
+/// A static btBvhTriangleMeshShape (at the identity, shifted by the scene's origin) over a
+/// rows x columns grid of quads whose corner (i, j) is point(i, j), i in 0..rows, j in
+/// 0..columns. Degenerate triangles (a bowl's pole) are left out. Returns the body.
+btRigidBody* addGridMesh(WorldScene& scene, int rows, int columns,
+                         const std::function<btVector3(int, int)>& point);
+
+/// A static hemispherical triangle-mesh bowl of `radius` (12 rings of 36 segments): bottom
+/// at y = 0, rim at y = radius. Returns the body.
+btRigidBody* addBowl(WorldScene& scene, double radius);
+
+/// Appends the world scenes of mesh_body_scenes.cpp: mesh bodies colliding mesh against mesh
+/// (kolize's narrowphase or GImpact, SceneOptions::meshMethod).
+void addMeshBodyScenes(std::vector<SceneEntry>& entries);
 
 /// Appends the scenes of Bullet's own benchmark (BenchmarkDemo), rebuilt from their
 /// description (bullet_benchmark_scenes.cpp).

@@ -28,12 +28,27 @@ void TimedDynamicsWorld::performDiscreteCollisionDetection() {
     const auto start = std::chrono::steady_clock::now();
     updateAabbs();
     computeOverlappingPairs();
-    lastBroadphaseSeconds_ = secondsSince(start);
+    lastBroadphaseSeconds_ += secondsSince(start);
     btDispatcher* dispatcher = getDispatcher();
     if (dispatcher != nullptr) {
+        const auto narrow = std::chrono::steady_clock::now();
         dispatcher->dispatchAllCollisionPairs(m_broadphasePairCache->getOverlappingPairCache(),
                                               getDispatchInfo(), dispatcher);
+        lastNarrowphaseSeconds_ += secondsSince(narrow);
     }
+    if (afterNarrowphase_) {
+        afterNarrowphase_();
+    }
+}
+
+void TimedDynamicsWorld::integrateTransforms(btScalar timeStep) {
+    const auto start = std::chrono::steady_clock::now();
+    if (meshCcd_) {
+        MeshCcdWorld::integrateTransforms(timeStep);
+    } else {
+        btDiscreteDynamicsWorld::integrateTransforms(timeStep);
+    }
+    lastIntegrateSeconds_ += secondsSince(start);
 }
 
 WorldScene::WorldScene(SceneInfo info, std::unique_ptr<btBroadphaseInterface> broadphase,
@@ -60,6 +75,7 @@ WorldScene::WorldScene(SceneInfo info, std::unique_ptr<btBroadphaseInterface> br
 }
 
 WorldScene::~WorldScene() {
+    world_->setAfterNarrowphase(nullptr);
     for (const std::unique_ptr<btTypedConstraint>& constraint : constraints_) {
         world_->removeConstraint(constraint.get());
     }
@@ -115,6 +131,7 @@ void WorldScene::removeBody(btRigidBody* body) {
         --dynamicBodies_;
     }
     world_->removeRigidBody(body);
+    exactMeshes_.erase(body);
     bodies_.erase(at);
     delete body->getMotionState();
     delete body;
@@ -131,6 +148,23 @@ void WorldScene::setContainer(const btVector3& min, const btVector3& max) {
     hasContainer_ = true;
     containerMin_ = min;
     containerMax_ = max;
+}
+
+void WorldScene::setExactMesh(const btCollisionObject* body,
+                              std::shared_ptr<const narrowphase::MeshModel> model) {
+    if (body == nullptr || !model) {
+        throw std::invalid_argument("scene '" + info_.name +
+                                    "': setExactMesh needs a body and a model");
+    }
+    exactMeshes_[body] = std::move(model);
+}
+
+void WorldScene::setContactAudit(bool on) {
+    if (!on) {
+        world_->setAfterNarrowphase(nullptr);
+        return;
+    }
+    world_->setAfterNarrowphase([this] { audit_ += auditContacts(*world_, exactMeshes_); });
 }
 
 void WorldScene::setRays(std::function<std::vector<WorldRay>(int frame)> rays) {
@@ -154,11 +188,14 @@ void WorldScene::step() {
     // Substeps as separate variable-size steps of exactly timeStep / substeps: no
     // accumulator, so every run (and every broadphase) takes the same steps.
     const btScalar h = btScalar(options_.timeStep / options_.substeps);
-    lastBroadphaseSeconds_ = 0;
+    lastBroadphaseSeconds_ = lastNarrowphaseSeconds_ = lastIntegrateSeconds_ = 0;
+    audit_ = ContactAudit();
     for (int i = 0; i < options_.substeps; ++i) {
         world_->resetBroadphaseSeconds();
         world_->stepSimulation(h, 0);
         lastBroadphaseSeconds_ += world_->lastBroadphaseSeconds();
+        lastNarrowphaseSeconds_ += world_->lastNarrowphaseSeconds();
+        lastIntegrateSeconds_ += world_->lastIntegrateSeconds();
     }
     ++frame_;
 }

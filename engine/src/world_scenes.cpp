@@ -132,29 +132,6 @@ void addWalls(WorldScene& scene, const btVector3& min, const btVector3& max, dou
     }
 }
 
-/// A static btBvhTriangleMeshShape over a rows x columns grid of quads whose corner (i, j)
-/// is point(i, j), i in 0..rows, j in 0..columns. Degenerate triangles (a bowl's pole) are
-/// left out.
-void addGridMesh(WorldScene& scene, int rows, int columns,
-                 const std::function<btVector3(int, int)>& point) {
-    auto* mesh = new btTriangleMesh();
-    scene.ownMesh(mesh);
-    auto triangle = [&](const btVector3& a, const btVector3& b, const btVector3& c) {
-        if ((b - a).cross(c - a).length2() > btScalar(1e-12)) {
-            mesh->addTriangle(a, b, c);
-        }
-    };
-    for (int i = 0; i < rows; ++i) {
-        for (int j = 0; j < columns; ++j) {
-            const btVector3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
-                            d = point(i, j + 1);
-            triangle(a, b, c);
-            triangle(a, c, d);
-        }
-    }
-    scene.addBody(scene.own(new btBvhTriangleMeshShape(mesh, true)), 0, at(vec(0, 0, 0)));
-}
-
 constexpr int kTerrainQuads = 64;
 constexpr double kTerrainQuad = 1.25;  // m: the terrain spans +-40 m
 constexpr double kTerrainHalf = kTerrainQuads * kTerrainQuad / 2;
@@ -170,16 +147,6 @@ void addTerrain(WorldScene& scene) {
     addGridMesh(scene, kTerrainQuads, kTerrainQuads, [](int i, int j) {
         const double x = -kTerrainHalf + i * kTerrainQuad, z = -kTerrainHalf + j * kTerrainQuad;
         return vec(x, terrainHeight(x, z), z);
-    });
-}
-
-/// A static hemispherical bowl of `radius`: bottom at y = 0, rim at y = radius.
-void addBowl(WorldScene& scene, double radius) {
-    constexpr int rings = 12, segments = 36;
-    addGridMesh(scene, rings, segments, [radius](int ring, int segment) {
-        const double theta = kPi / 2 * ring / rings, phi = 2 * kPi * segment / segments;
-        return vec(radius * std::sin(theta) * std::cos(phi), radius * (1 - std::cos(theta)),
-                   radius * std::sin(theta) * std::sin(phi));
     });
 }
 
@@ -471,6 +438,36 @@ std::string mixedWhy(const std::string& mesh, bool rays) {
 }
 
 }  // namespace
+
+btRigidBody* addGridMesh(WorldScene& scene, int rows, int columns,
+                         const std::function<btVector3(int, int)>& point) {
+    auto* mesh = new btTriangleMesh();
+    scene.ownMesh(mesh);
+    auto triangle = [&](const btVector3& a, const btVector3& b, const btVector3& c) {
+        if ((b - a).cross(c - a).length2() > btScalar(1e-12)) {
+            mesh->addTriangle(a, b, c);
+        }
+    };
+    for (int i = 0; i < rows; ++i) {
+        for (int j = 0; j < columns; ++j) {
+            const btVector3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
+                            d = point(i, j + 1);
+            triangle(a, b, c);
+            triangle(a, c, d);
+        }
+    }
+    return scene.addBody(scene.own(new btBvhTriangleMeshShape(mesh, true)), 0,
+                         btTransform::getIdentity());
+}
+
+btRigidBody* addBowl(WorldScene& scene, double radius) {
+    constexpr int rings = 12, segments = 36;
+    return addGridMesh(scene, rings, segments, [radius](int ring, int segment) {
+        const double theta = kPi / 2 * ring / rings, phi = 2 * kPi * segment / segments;
+        return vec(radius * std::sin(theta) * std::cos(phi), radius * (1 - std::cos(theta)),
+                   radius * std::sin(theta) * std::sin(phi));
+    });
+}
 
 void addWorldScenes(std::vector<SceneEntry>& entries) {
     auto add = [&](SceneInfo info, SceneBuilder builder) {

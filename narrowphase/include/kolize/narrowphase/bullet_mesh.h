@@ -20,7 +20,10 @@
 /// none (there is no contact margin in this version). The pairs are grouped into patches
 /// (pairs whose triangles share a vertex index on either mesh). Per patch, the normal n and
 /// the depth come from a separating-axis test on the patch's own triangles: the candidate
-/// directions are their face normals (A's outward, B's reversed; the 64 with the longest
+/// directions are their face normals (A's outward, B's reversed; outward is the winding's
+/// side for a closed mesh, the side away from the body's origin for an open one, and for
+/// btBvhTriangleMeshShape scenery, which is two-sided as in Bullet, the side towards the
+/// mesh body's origin: a bowl wound either way holds what falls in; the 64 with the longest
 /// intersections) and NARROWPHASE.md's `normalize(sum of w (n_A - n_B))` (w the segment's
 /// length, the square root of the overlap area for coplanar pairs); the one along which A's
 /// patch vertices and B's overlap least is n (from A towards B), the overlap is the depth.
@@ -35,7 +38,10 @@
 /// triangle). The manifold is persistent: Bullet's refreshContactPoints() drops the points
 /// that moved apart, as for its own algorithms. A body at rest is mostly held by these kept
 /// points (the solver leaves it touching or a hair apart, where the exact test finds no
-/// new pair); contactTest/contactPairTest then report nothing until the meshes touch.
+/// new pair); contactTest/contactPairTest then report nothing until the meshes touch. When the
+/// exact test finds the meshes apart, a kept point's distance (recomputed by Bullet from where
+/// the point was on the bodies) reads as touching (0) at most: no penetration is claimed
+/// between meshes that do not intersect, so nothing is pushed apart that is not in contact.
 ///
 /// Continuous collision: the mesh algorithms' calculateTimeOfImpact is the exact first
 /// contact of the two moving meshes (kolize::ccd::meshCcd; see MeshContactAlgorithm), and

@@ -1,0 +1,288 @@
+// kolize-mesh-world: the mesh-body scenes (group mesh-world) once per mesh method (kolize's
+// narrowphase, GImpact with margin 0 and with its default margin), stepped side by side:
+// each frame steps every method's world once, in an order that rotates per frame, so the
+// machine's noise hits them alike. Per scene and method: the median step and narrowphase
+// time, contacts, the deepest contact, energy gained, escaped (tunnelled) bodies, NaN, and an
+// exact audit of the contacts every few frames (contact_audit.h): pairs whose manifold claims
+// a penetration the exact triangle test does not find (invented), and exactly intersecting
+// pairs without a contact (missing).
+
+#include "../common/split.h"
+
+#include <kolize/engine/scene.h>
+#include <kolize/engine/statistics.h>
+#include <kolize/engine/world_scene.h>
+#include <kolize/kolize.h>
+
+#include <btBulletDynamicsCommon.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char* const kUsage =
+    "usage: kolize-mesh-world [options]\n"
+    "  --scene LIST        mesh-world scenes, comma separated, or all (default all)\n"
+    "  --method LIST       kolize, gimpact-0, gimpact (default all three)\n"
+    "  --frames N          frames per run (default 180)\n"
+    "  --n N               objects (default: the scene's)\n"
+    "  --timestep T        seconds per frame, e.g. 1/120 (default 1/60)\n"
+    "  --substeps K        solver substeps per frame (default 1)\n"
+    "  --ccd auto|on|off   CCD (kolize: its mesh CCD; default: on where the scene needs it)\n"
+    "  --audit-every K     exact contact audit every K-th frame, 0 = never (default 5)\n"
+    "  --broadphase NAME   the broadphase of every run (default sweep)\n"
+    "  --seed S            scene seed (default 1)\n"
+    "  --csv FILE          also write one line per scene and method\n";
+
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "kolize-mesh-world: %s (try --help)\n", message.c_str());
+    std::exit(2);
+}
+
+struct Options {
+    std::vector<std::string> scenes;
+    std::vector<std::string> methods = {"kolize", "gimpact-0", "gimpact"};
+    int frames = 180;
+    int auditEvery = 5;
+    std::string broadphase = "sweep";
+    std::string csv;
+    kolize::SceneOptions scene;
+};
+
+long wholeNumber(const std::string& flag, const std::string& text, long low, long high) {
+    char* end = nullptr;
+    const long value = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || value < low || value > high) {
+        fail(flag + " needs a whole number in " + std::to_string(low) + ".." +
+             std::to_string(high) + ", got '" + text + "'");
+    }
+    return value;
+}
+
+double seconds(const std::string& text) {
+    const std::size_t slash = text.find('/');
+    char* end = nullptr;
+    double value = std::strtod(text.c_str(), &end);
+    if (slash != std::string::npos && end == text.c_str() + slash) {
+        const double divisor = std::strtod(text.c_str() + slash + 1, &end);
+        value = divisor != 0 ? value / divisor : 0;
+    }
+    if (text.empty() || *end != '\0' || !(value > 0) || !(value <= 10)) {
+        fail("--timestep needs a time in seconds in (0, 10], got '" + text + "'");
+    }
+    return value;
+}
+
+std::vector<std::string> meshWorldScenes() {
+    std::vector<std::string> out;
+    for (const kolize::SceneInfo& info : kolize::sceneList()) {
+        if (info.group == "mesh-world") {
+            out.push_back(info.name);
+        }
+    }
+    return out;
+}
+
+std::vector<std::string> chosen(const std::string& flag, const std::string& text,
+                                const std::vector<std::string>& valid) {
+    if (text == "all") {
+        return valid;
+    }
+    const std::vector<std::string> out = kolize::demo::split(text, ',');
+    if (out.empty()) {
+        fail(flag + " needs at least one name");
+    }
+    for (const std::string& name : out) {
+        if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
+            std::string names;
+            for (const std::string& v : valid) {
+                names += (names.empty() ? "" : ", ") + v;
+            }
+            fail(flag + ": unknown name '" + name + "'; valid: all, " + names);
+        }
+    }
+    return out;
+}
+
+Options parse(int argc, char** argv) {
+    Options options;
+    options.scenes = meshWorldScenes();
+    for (int i = 1; i < argc; ++i) {
+        const std::string flag = argv[i];
+        if (flag == "--help" || flag == "-h") {
+            std::printf("%s", kUsage);
+            std::exit(0);
+        }
+        if (i + 1 >= argc) {
+            fail(flag.rfind("--", 0) == 0 ? flag + " needs a value"
+                                          : "unknown argument '" + flag + "'");
+        }
+        const std::string value = argv[++i];
+        if (flag == "--scene") {
+            options.scenes = chosen(flag, value, meshWorldScenes());
+        } else if (flag == "--method") {
+            options.methods = chosen(flag, value, {"kolize", "gimpact-0", "gimpact"});
+        } else if (flag == "--frames") {
+            options.frames = int(wholeNumber(flag, value, 1, 1000000));
+        } else if (flag == "--n") {
+            options.scene.objects = int(wholeNumber(flag, value, 1, 100000));
+        } else if (flag == "--timestep") {
+            options.scene.timeStep = seconds(value);
+        } else if (flag == "--substeps") {
+            options.scene.substeps = int(wholeNumber(flag, value, 1, 1000));
+        } else if (flag == "--ccd") {
+            if (value != "auto" && value != "on" && value != "off") {
+                fail("--ccd takes auto, on or off, got '" + value + "'");
+            }
+            options.scene.bulletCcd = value == "auto" ? -1 : value == "on" ? 1 : 0;
+        } else if (flag == "--audit-every") {
+            options.auditEvery = int(wholeNumber(flag, value, 0, 1000000));
+        } else if (flag == "--broadphase") {
+            const std::vector<std::string> names = kolize::broadphaseNames();
+            if (std::find(names.begin(), names.end(), value) == names.end()) {
+                fail("--broadphase: unknown name '" + value + "'");
+            }
+            options.broadphase = value;
+        } else if (flag == "--seed") {
+            options.scene.seed = std::uint32_t(wholeNumber(flag, value, 0, 4294967295L));
+        } else if (flag == "--csv") {
+            options.csv = value;
+        } else {
+            fail("unknown option '" + flag + "'");
+        }
+    }
+    return options;
+}
+
+/// One method's run of one scene.
+struct Run {
+    std::string method;
+    std::unique_ptr<kolize::Scene> scene;
+    kolize::WorldScene* world = nullptr;
+    std::vector<double> stepMs, narrowMs, integrateMs, contacts;
+    double initialEnergy = 0, energyGain = 0, deepest = 0;
+    int escaped = 0, nonFinite = 0;
+    kolize::ContactAudit audit;
+};
+
+int contactPoints(kolize::WorldScene& world) {
+    int points = 0;
+    btCollisionDispatcher& dispatcher = world.dispatcher();
+    for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
+        points += dispatcher.getManifoldByIndexInternal(i)->getNumContacts();
+    }
+    return points;
+}
+
+void stepOnce(Run& run, bool audit) {
+    run.world->setContactAudit(audit);
+    const auto start = std::chrono::steady_clock::now();
+    run.scene->step();
+    run.stepMs.push_back(
+        1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    run.narrowMs.push_back(1e3 * run.world->lastNarrowphaseSeconds());
+    run.integrateMs.push_back(1e3 * run.world->lastIntegrateSeconds());
+    run.contacts.push_back(contactPoints(*run.world));
+    const kolize::SceneState state = run.scene->state();
+    run.energyGain =
+        std::max(run.energyGain, state.kineticEnergy + state.potentialEnergy - run.initialEnergy);
+    run.deepest = std::max(run.deepest, state.maxPenetration);
+    run.escaped = std::max(run.escaped, state.escaped);
+    run.nonFinite = std::max(run.nonFinite, state.nonFinite);
+    if (audit) {
+        run.audit += run.world->lastAudit();
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Options options = parse(argc, argv);
+    std::FILE* csv = nullptr;
+    if (!options.csv.empty() && (csv = std::fopen(options.csv.c_str(), "w")) == nullptr) {
+        fail("cannot write '" + options.csv + "'");
+    }
+    if (csv != nullptr) {
+        std::fprintf(csv,
+                     "scene,method,frames,timestep,substeps,ccd,step_ms,narrow_ms,integrate_ms,"
+                     "contacts,deepest_m,energy_gain_j,escaped,nonfinite,audited_pairs,"
+                     "intersecting,invented,missing,max_false_depth_m\n");
+    }
+    std::printf(
+        "kolize-mesh-world: Bullet %d, %s precision, broadphase %s, seed %u, %d frames of %.5g s "
+        "(%d substeps); times are medians over frames, the methods stepped in turn each frame; "
+        "contacts audited exactly every %d frames\n",
+        btGetVersion(), sizeof(btScalar) == 8 ? "double" : "float", options.broadphase.c_str(),
+        options.scene.seed, options.frames, options.scene.timeStep, options.scene.substeps,
+        options.auditEvery);
+    for (const std::string& sceneName : options.scenes) {
+        const kolize::SceneInfo& info = kolize::findScene(sceneName);
+        std::printf("\n== scene %s: %s\n", sceneName.c_str(), info.summary.c_str());
+        std::vector<Run> runs;
+        for (const std::string& method : options.methods) {
+            kolize::SceneOptions sceneOptions = options.scene;
+            sceneOptions.meshMethod = method;
+            Run run;
+            run.method = method;
+            run.scene = kolize::makeScene(
+                sceneName,
+                kolize::makeBroadphase(options.broadphase,
+                                       kolize::broadphaseSettingsFor(info, sceneOptions)),
+                sceneOptions);
+            run.world = static_cast<kolize::WorldScene*>(run.scene.get());
+            const kolize::SceneState state = run.scene->state();
+            run.initialEnergy = state.kineticEnergy + state.potentialEnergy;
+            runs.push_back(std::move(run));
+        }
+        for (int frame = 0; frame < options.frames; ++frame) {
+            const bool audit = options.auditEvery > 0 && frame % options.auditEvery == 0;
+            for (std::size_t k = 0; k < runs.size(); ++k) {
+                stepOnce(runs[(k + std::size_t(frame)) % runs.size()], audit);
+            }
+        }
+        std::printf("%-10s %8s %9s %9s %8s %9s %10s %7s %4s %7s %6s %8s %7s %10s\n", "method",
+                    "step ms", "narrow ms", "integr ms", "contacts", "deepest", "energy+ J",
+                    "escaped", "NaN", "audited", "inters", "invented", "missing", "false dep");
+        for (Run& run : runs) {
+            const double step = kolize::median(run.stepMs), narrow = kolize::median(run.narrowMs),
+                         integrate = kolize::median(run.integrateMs),
+                         contacts = kolize::median(run.contacts);
+            std::printf(
+                "%-10s %8.3f %9.3f %9.3f %8.0f %9.2e %10.3g %7d %4d %7d %6d %8d %7d %10.2e\n",
+                run.method.c_str(), step, narrow, integrate, contacts, run.deepest, run.energyGain,
+                run.escaped, run.nonFinite, run.audit.pairs, run.audit.intersecting,
+                run.audit.invented, run.audit.missing, run.audit.maxFalseDepth);
+            if (csv != nullptr) {
+                std::fprintf(
+                    csv,
+                    "%s,%s,%d,%.8g,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%d,%d,%.6g\n",
+                    sceneName.c_str(), run.method.c_str(), options.frames, options.scene.timeStep,
+                    options.scene.substeps, run.world->world()->meshCcd() ? 1 : 0, step, narrow,
+                    integrate, contacts, run.deepest, run.energyGain, run.escaped, run.nonFinite,
+                    run.audit.pairs, run.audit.intersecting, run.audit.invented, run.audit.missing,
+                    run.audit.maxFalseDepth);
+            }
+        }
+        const auto kolizeRun = std::find_if(runs.begin(), runs.end(),
+                                            [](const Run& run) { return run.method == "kolize"; });
+        for (const Run& run : runs) {
+            if (kolizeRun != runs.end() && run.method != "kolize") {
+                std::printf("narrowphase time, kolize / %s: %.2f\n", run.method.c_str(),
+                            kolize::median(kolizeRun->narrowMs) /
+                                std::max(1e-9, kolize::median(run.narrowMs)));
+            }
+        }
+    }
+    if (csv != nullptr) {
+        std::fclose(csv);
+    }
+    return 0;
+}

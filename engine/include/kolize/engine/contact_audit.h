@@ -1,0 +1,45 @@
+#pragma once
+/// \file
+/// An independent check of a world's contacts: every overlapping pair of two bodies whose
+/// exact triangle meshes are known is queried exactly (kolize's mesh query, yes/no, closed:
+/// touching counts) at the poses the narrowphase saw, and compared with the pair's contact
+/// manifold, whichever algorithm made it (kolize's, GImpact's, Bullet's convex ones).
+
+#include <kolize/narrowphase/mesh_model.h>
+
+#include <map>
+#include <memory>
+
+class btCollisionWorld;
+class btCollisionObject;
+
+namespace kolize {
+
+/// Exact meshes by body: each in its body frame (the body's world transform places it).
+using ExactMeshes =
+    std::map<const btCollisionObject*, std::shared_ptr<const narrowphase::MeshModel>>;
+
+/// What an audit found (sums over the audited steps).
+struct ContactAudit {
+    int pairs = 0;         ///< overlapping pairs of two bodies with exact meshes
+    int intersecting = 0;  ///< of those, pairs whose meshes share a point
+    /// Pairs whose manifold claims a penetration (a point deeper than kInventedDepth) while
+    /// the meshes are apart: a contact that is not there (a margin's, or a stale point).
+    int invented = 0;
+    /// Intersecting pairs without a manifold point (none at all, or none closer than
+    /// kInventedDepth): a contact that is there and was not reported.
+    int missing = 0;
+    double maxFalseDepth = 0;  ///< deepest claimed penetration among the invented pairs (m)
+    int steps = 0;             ///< audited steps
+    ContactAudit& operator+=(const ContactAudit& other);
+};
+
+/// Claims of penetration shallower than this (m) are not counted as invented: a point the
+/// solver left touching may read a hair inside after the float round trip.
+constexpr double kInventedDepth = 1e-4;
+
+/// Audits `world` now (call it after the narrowphase, before the bodies move). Bodies not
+/// in `meshes` are skipped. Cost: one exact yes/no query per overlapping pair with meshes.
+ContactAudit auditContacts(const btCollisionWorld& world, const ExactMeshes& meshes);
+
+}  // namespace kolize
