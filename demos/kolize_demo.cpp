@@ -47,7 +47,9 @@ const char* kUsage =
     "  --timestep T              seconds per frame, e.g. 0.01 or 1/60 (default 1/60)\n"
     "  --substeps K              solver steps per frame, each T/K (default 1)\n"
     "  --bullet-ccd auto|on|off  Bullet's own CCD for dynamic bodies (default auto: on in\n"
-    "                            scenes with fast objects)\n"
+    "                            scenes with fast objects; kolize mesh bodies: its mesh CCD)\n"
+    "  --mesh-method M           kolize, gimpact or gimpact-0: how the mesh-world scenes'\n"
+    "                            meshes collide (default kolize; kolize-mesh-world compares)\n"
     "  --reference-substeps K    also run each scene with K times the substeps and report\n"
     "                            the bodies' drift from it at the last frame\n"
     "  --fat-margin F            kolize broadphases: fat-box margin, a fraction of each\n"
@@ -205,6 +207,11 @@ Options parse(int argc, char** argv) {
                 fail("--bullet-ccd takes auto, on or off, got '" + value + "'");
             }
             options.scene.bulletCcd = value == "auto" ? -1 : value == "on" ? 1 : 0;
+        } else if (flag == "--mesh-method") {
+            if (value != "kolize" && value != "gimpact" && value != "gimpact-0") {
+                fail("--mesh-method takes kolize, gimpact or gimpact-0, got '" + value + "'");
+            }
+            options.scene.meshMethod = value;
         } else if (flag == "--reference-substeps") {
             options.referenceSubsteps = int(wholeNumber(flag, value, 2, 1000));
         } else if (flag == "--fat-margin") {
@@ -359,12 +366,16 @@ void printPipeline(const kolize::SceneInfo& info, const kolize::SceneOptions& op
     if (needs.rays) {
         stages += ", ray casts (timed apart)";
     }
+    const bool meshBodies = info.group == "mesh-world";
     if (needs.meshes) {
-        stages += ", triangle meshes";
+        stages += meshBodies ? ", mesh bodies (" + options.meshMethod + " narrowphase)"
+                             : ", triangle meshes";
     }
     const bool ccd = options.bulletCcd < 0 ? needs.continuous : options.bulletCcd > 0;
     if (needs.dynamics && ccd) {
-        stages += ", Bullet's CCD";
+        stages += meshBodies && options.meshMethod == "kolize" ? ", kolize's mesh CCD"
+                  : meshBodies                                 ? ", no CCD (GImpact has none)"
+                                                               : ", Bullet's CCD";
     }
     std::printf("pipeline: %s\n  why: %s%s\n", stages.c_str(), info.pipelineWhy.c_str(),
                 needs.dynamics && options.bulletCcd >= 0 && ccd != needs.continuous

@@ -286,9 +286,12 @@ void fillWall(WorldScene& scene, MeshBodies& bodies, Rng& rng, int count) {
     for (const char* file : kPileModels) {
         models.push_back(assetModel(scene.options(), file, kWallBodySize));
     }
-    // One lane per body, 1 m apart along z; the wall spans them all, 4 m high.
-    const double halfSpan = 0.5 * count + 1;
-    bodies.add(boxModel(Vec3(kWallHalfThickness, 2, halfSpan)), 0, at(vec(0, 2, halfSpan - 1.5)));
+    // One lane per body, 1 m apart along z, in front of a wall 40 m high and 60 m wider than
+    // the lanes on each side (a fast body deflected upwards stays in front of it), standing on
+    // a ground (a box mesh, top at y = 0) where the bodies land after the hit.
+    const double middle = 0.5 * (count - 1), halfSpan = 0.5 * count + 60;
+    bodies.add(boxModel(Vec3(kWallHalfThickness, 20, halfSpan)), 0, at(vec(0, 20, middle)));
+    bodies.add(boxModel(Vec3(100, 0.5, halfSpan + 40)), 0, at(vec(0, -0.5, middle)));
     for (int i = 0; i < count; ++i) {
         // Speeds from 1 to 200 m/s, geometrically spaced; every body reaches the wall
         // after about 0.1 s (a few centimetres of fall).
@@ -361,7 +364,7 @@ void addMeshBodyScenes(std::vector<SceneEntry>& entries) {
          0, 30},
         buildMeshScene<fillPile>);
     add({"mesh-wall",
-         "N (default 8) 0.5 m mesh bodies thrown at a 2 cm mesh wall at 1 to 200 m/s "
+         "N (default 8) 0.5 m mesh bodies thrown at a 2 cm mesh wall (40 m high) at 1 to 200 m/s "
          "(geometric steps), one lane each; escaped = tunnelled",
          "mesh-world", 8, meshNeeds(true),
          "dynamics: the bodies hit the wall; no rays: nothing casts; " + method +
