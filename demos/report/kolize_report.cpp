@@ -203,12 +203,14 @@ int main(int argc, char** argv) {
         "tables 2.3-2.7, scaling, error against run time (sweeps), the store-only lower bound, "
         "2D against Box2D, then the Bullet worlds from kolize-demo: pair output live and "
         "replayed, rays, determinism, dynamics accuracy against time, numerical stability; then "
-        "the narrowphase (mesh against mesh) against FCL and GImpact; the differential "
+        "the narrowphase (mesh against mesh) against FCL and GImpact; mesh bodies in Bullet "
+        "worlds against GImpact; the differential "
         "fuzzer's table.\n");
 
     using Section = void (*)(Context&);
-    for (Section section : {thesisSection, scalingSection, sweepSection, lowerBoundSection,
-                            box2dSection, demoSections, narrowSection, fuzzSection}) {
+    for (Section section :
+         {thesisSection, scalingSection, sweepSection, lowerBoundSection, box2dSection,
+          demoSections, narrowSection, meshWorldSection, fuzzSection}) {
         section(context);
     }
 

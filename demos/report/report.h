@@ -56,6 +56,7 @@ void lowerBoundSection(Context& context);
 void box2dSection(Context& context);
 void demoSections(Context& context);
 void narrowSection(Context& context);
+void meshWorldSection(Context& context);
 void fuzzSection(Context& context);
 
 }  // namespace report

@@ -463,7 +463,8 @@ std::string formatScale(const btVector3& s) {
 std::shared_ptr<const MeshModel> makeMeshModel(TriangleMesh mesh, int leafSize) {
     narrowphase::TreeSettings settings;
     settings.kind = narrowphase::TreeKind::kObb;
-    settings.leaf_size = leafSize;
+    settings.leaf_size =
+        leafSize != 0 ? leafSize : mesh.triangleCount() <= std::size_t(kSmallMesh) ? 1 : 4;
     return std::make_shared<const MeshModel>(std::make_shared<const TriangleMesh>(std::move(mesh)),
                                              settings);
 }

@@ -71,11 +71,16 @@ class btPersistentManifold;
 
 namespace kolize {
 
-/// Builds the model a MeshShape needs (an OBB tree, leaf size from `leafSize`, default 4).
+/// Builds the model a MeshShape needs: an OBB tree with `leafSize` triangles per leaf (1..8),
+/// or with the default 0, 1 for meshes of up to kSmallMesh triangles and 4 above. (A box
+/// mesh used as a ground has leaves of 4 triangles from different faces, each as large as
+/// the box: every node of a mesh resting on it overlaps them, and the query visits all of
+/// its leaves; with one triangle per leaf the top face's leaves are flat and reject them.)
 /// Bad mesh data is refused by TriangleMesh itself (narrowphase::MeshError naming the mesh
 /// and the element: non-finite vertex, index out of range, no triangles).
+constexpr int kSmallMesh = 64;
 std::shared_ptr<const narrowphase::MeshModel> makeMeshModel(narrowphase::TriangleMesh mesh,
-                                                            int leafSize = 4);
+                                                            int leafSize = 0);
 
 /// Volume integrals of a closed mesh (density 1), in its model frame.
 struct MeshMassProperties {
