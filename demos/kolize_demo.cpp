@@ -5,6 +5,8 @@
 // drift from a fine-step reference, a replay of one recorded stream into every broadphase,
 // and a bit-for-bit comparison with btSimpleBroadphase under deterministic pair order.
 
+#include "common/cli.h"
+
 #include <kolize/engine/pair_compare.h>
 #include <kolize/engine/pair_stream.h>
 #include <kolize/engine/scene.h>
@@ -87,31 +89,6 @@ struct Options {
     std::string record, replay, csv, json;
 };
 
-long wholeNumber(const std::string& flag, const std::string& text, long low, long high) {
-    char* end = nullptr;
-    const long value = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || value < low || value > high) {
-        fail(flag + " needs a whole number in " + std::to_string(low) + ".." +
-             std::to_string(high) + ", got '" + text + "'");
-    }
-    return value;
-}
-
-double seconds(const std::string& flag, const std::string& text) {
-    const std::size_t slash = text.find('/');
-    char* end = nullptr;
-    double value = std::strtod(text.c_str(), &end);
-    if (slash != std::string::npos && end == text.c_str() + slash) {
-        const char* denominator = text.c_str() + slash + 1;
-        const double divisor = std::strtod(denominator, &end);
-        value = divisor != 0 ? value / divisor : 0;
-    }
-    if (text.empty() || *end != '\0' || !(value > 0) || !(value <= 10)) {
-        fail(flag + " needs a time in seconds in (0, 10], e.g. 0.01 or 1/60, got '" + text + "'");
-    }
-    return value;
-}
-
 std::vector<std::string> list(const std::string& text) {
     std::vector<std::string> out;
     std::stringstream stream(text);
@@ -186,22 +163,23 @@ Options parse(int argc, char** argv) {
             options.broadphases =
                 chosen(flag, value, kolize::broadphaseNames(), kolize::broadphaseNameList());
         } else if (flag == "--n") {
-            options.scene.objects = int(wholeNumber(flag, value, 1, 10000000));
+            options.scene.objects = int(kolize::demo::wholeNumber(flag, value, 1, 10000000, fail));
         } else if (flag == "--frames") {
-            options.frames = int(wholeNumber(flag, value, 1, 1000000));
+            options.frames = int(kolize::demo::wholeNumber(flag, value, 1, 1000000, fail));
         } else if (flag == "--replay-rounds") {
-            options.replayRounds = int(wholeNumber(flag, value, 1, 100));
+            options.replayRounds = int(kolize::demo::wholeNumber(flag, value, 1, 100, fail));
         } else if (flag == "--seed") {
-            options.scene.seed = std::uint32_t(wholeNumber(flag, value, 0, 4294967295L));
+            options.scene.seed =
+                std::uint32_t(kolize::demo::wholeNumber(flag, value, 0, 4294967295L, fail));
         } else if (flag == "--motion") {
             if (value != "slow" && value != "fast") {
                 fail("--motion takes slow or fast, got '" + value + "'");
             }
             options.scene.motion = value;
         } else if (flag == "--timestep") {
-            options.scene.timeStep = seconds(flag, value);
+            options.scene.timeStep = kolize::demo::seconds(flag, value, fail);
         } else if (flag == "--substeps") {
-            options.scene.substeps = int(wholeNumber(flag, value, 1, 1000));
+            options.scene.substeps = int(kolize::demo::wholeNumber(flag, value, 1, 1000, fail));
         } else if (flag == "--bullet-ccd") {
             if (value != "auto" && value != "on" && value != "off") {
                 fail("--bullet-ccd takes auto, on or off, got '" + value + "'");
@@ -213,7 +191,7 @@ Options parse(int argc, char** argv) {
             }
             options.scene.meshMethod = value;
         } else if (flag == "--reference-substeps") {
-            options.referenceSubsteps = int(wholeNumber(flag, value, 2, 1000));
+            options.referenceSubsteps = int(kolize::demo::wholeNumber(flag, value, 2, 1000, fail));
         } else if (flag == "--fat-margin") {
             char* end = nullptr;
             options.fatMargin = std::strtod(value.c_str(), &end);

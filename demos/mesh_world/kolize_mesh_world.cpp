@@ -7,6 +7,7 @@
 // a penetration the exact triangle test does not find (invented), and exactly intersecting
 // pairs without a contact (missing).
 
+#include "../common/cli.h"
 #include "../common/split.h"
 
 #include <kolize/engine/scene.h>
@@ -56,30 +57,6 @@ struct Options {
     std::string csv;
     kolize::SceneOptions scene;
 };
-
-long wholeNumber(const std::string& flag, const std::string& text, long low, long high) {
-    char* end = nullptr;
-    const long value = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || value < low || value > high) {
-        fail(flag + " needs a whole number in " + std::to_string(low) + ".." +
-             std::to_string(high) + ", got '" + text + "'");
-    }
-    return value;
-}
-
-double seconds(const std::string& text) {
-    const std::size_t slash = text.find('/');
-    char* end = nullptr;
-    double value = std::strtod(text.c_str(), &end);
-    if (slash != std::string::npos && end == text.c_str() + slash) {
-        const double divisor = std::strtod(text.c_str() + slash + 1, &end);
-        value = divisor != 0 ? value / divisor : 0;
-    }
-    if (text.empty() || *end != '\0' || !(value > 0) || !(value <= 10)) {
-        fail("--timestep needs a time in seconds in (0, 10], got '" + text + "'");
-    }
-    return value;
-}
 
 std::vector<std::string> meshWorldScenes() {
     std::vector<std::string> out;
@@ -131,20 +108,20 @@ Options parse(int argc, char** argv) {
         } else if (flag == "--method") {
             options.methods = chosen(flag, value, {"kolize", "gimpact-0", "gimpact"});
         } else if (flag == "--frames") {
-            options.frames = int(wholeNumber(flag, value, 1, 1000000));
+            options.frames = int(kolize::demo::wholeNumber(flag, value, 1, 1000000, fail));
         } else if (flag == "--n") {
-            options.scene.objects = int(wholeNumber(flag, value, 1, 100000));
+            options.scene.objects = int(kolize::demo::wholeNumber(flag, value, 1, 100000, fail));
         } else if (flag == "--timestep") {
-            options.scene.timeStep = seconds(value);
+            options.scene.timeStep = kolize::demo::seconds(flag, value, fail);
         } else if (flag == "--substeps") {
-            options.scene.substeps = int(wholeNumber(flag, value, 1, 1000));
+            options.scene.substeps = int(kolize::demo::wholeNumber(flag, value, 1, 1000, fail));
         } else if (flag == "--ccd") {
             if (value != "auto" && value != "on" && value != "off") {
                 fail("--ccd takes auto, on or off, got '" + value + "'");
             }
             options.scene.bulletCcd = value == "auto" ? -1 : value == "on" ? 1 : 0;
         } else if (flag == "--audit-every") {
-            options.auditEvery = int(wholeNumber(flag, value, 0, 1000000));
+            options.auditEvery = int(kolize::demo::wholeNumber(flag, value, 0, 1000000, fail));
         } else if (flag == "--broadphase") {
             const std::vector<std::string> names = kolize::broadphaseNames();
             if (std::find(names.begin(), names.end(), value) == names.end()) {
@@ -152,7 +129,8 @@ Options parse(int argc, char** argv) {
             }
             options.broadphase = value;
         } else if (flag == "--seed") {
-            options.scene.seed = std::uint32_t(wholeNumber(flag, value, 0, 4294967295L));
+            options.scene.seed =
+                std::uint32_t(kolize::demo::wholeNumber(flag, value, 0, 4294967295L, fail));
         } else if (flag == "--csv") {
             options.csv = value;
         } else {

@@ -223,18 +223,6 @@ double uniform(Rng& rng, double lo, double hi) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
 
-btQuaternion randomRotation(Rng& rng) {
-    std::normal_distribution<double> normal;
-    for (;;) {
-        const double x = normal(rng), y = normal(rng), z = normal(rng), w = normal(rng);
-        const double length = std::sqrt(x * x + y * y + z * z + w * w);
-        if (length > 1e-9) {
-            return btQuaternion(btScalar(x / length), btScalar(y / length), btScalar(z / length),
-                                btScalar(w / length));
-        }
-    }
-}
-
 /// The lowest y of the model's vertices.
 double bottomOf(const Model& model) {
     double bottom = 1e300;

@@ -5,8 +5,11 @@
 
 #include <kolize/engine/scene.h>
 
+#include <LinearMath/btQuaternion.h>
+
 #include <functional>
 #include <memory>
+#include <random>
 #include <vector>
 
 class btRigidBody;
@@ -30,6 +33,9 @@ const std::vector<SceneEntry>& sceneEntries();
 void addWorldScenes(std::vector<SceneEntry>& entries);
 
 class WorldScene;
+
+/// A uniformly distributed rotation (a normalised 4D Gaussian sample).
+btQuaternion randomRotation(std::mt19937& rng);
 
 /// A static btBvhTriangleMeshShape (at the identity, shifted by the scene's origin) over a
 /// rows x columns grid of quads whose corner (i, j) is point(i, j), i in 0..rows, j in

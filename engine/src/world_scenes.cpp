@@ -65,19 +65,6 @@ btVector3 randomDirection(Rng& rng) {
     }
 }
 
-/// A uniformly distributed rotation (a normalised 4D Gaussian sample).
-btQuaternion randomRotation(Rng& rng) {
-    std::normal_distribution<double> normal;
-    for (;;) {
-        const double x = normal(rng), y = normal(rng), z = normal(rng), w = normal(rng);
-        const double length = std::sqrt(x * x + y * y + z * z + w * w);
-        if (length > 1e-9) {
-            return btQuaternion(btScalar(x / length), btScalar(y / length), btScalar(z / length),
-                                btScalar(w / length));
-        }
-    }
-}
-
 SceneNeeds needs(bool rays, bool meshes, bool continuous) {
     SceneNeeds out;
     out.rays = rays;
@@ -438,6 +425,18 @@ std::string mixedWhy(const std::string& mesh, bool rays) {
 }
 
 }  // namespace
+
+btQuaternion randomRotation(std::mt19937& rng) {
+    std::normal_distribution<double> normal;
+    for (;;) {
+        const double x = normal(rng), y = normal(rng), z = normal(rng), w = normal(rng);
+        const double length = std::sqrt(x * x + y * y + z * z + w * w);
+        if (length > 1e-9) {
+            return btQuaternion(btScalar(x / length), btScalar(y / length), btScalar(z / length),
+                                btScalar(w / length));
+        }
+    }
+}
 
 btRigidBody* addGridMesh(WorldScene& scene, int rows, int columns,
                          const std::function<btVector3(int, int)>& point) {
