@@ -81,8 +81,8 @@ struct MeshStageSettings {
 /// processCollision of a mesh-mesh pair (with finite transforms) or of a mesh-scenery pair
 /// that found scenery triangles in the mesh's box. Identities:
 /// object_sphere_tests + sphere_skipped_auto + sphere_skipped_off = mesh queries (mesh_mesh +
-/// mesh_scenery), and object_sphere_tests - object_sphere_rejects = tree_queries +
-/// no_tree_tiny + no_tree_off.
+/// mesh_scenery), and mesh queries - object_sphere_rejects = tree_queries + no_tree_tiny +
+/// no_tree_off.
 struct MeshStageStats {
     MeshStageSettings settings;  ///< the dispatcher's settings
 
