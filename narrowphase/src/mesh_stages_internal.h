@@ -106,7 +106,8 @@ class PairStages {
     Sphere sphere_ = Sphere::kTested;
     Tree tree_ = Tree::kUsed;
     bool measuring_ = false;  // this query's sphere test belongs to an auto window
-    bool offEnded_ = false;   // this query is the first after an off period
+    bool offEnded_ = false;   // this query is the last of an off period
+    bool touching_ = false;   // the previous query found intersecting triangles
     int measured_ = 0;        // queries of the current window
     int rejects_ = 0;
     int offLeft_ = 0;  // queries still to skip the test
