@@ -2,6 +2,8 @@
 
 #include "kolize/narrowphase/mesh_ccd.h"
 
+#include "mesh_stages_internal.h"
+
 #include <BulletCollision/CollisionDispatch/btCollisionConfiguration.h>
 #include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
 #include <LinearMath/btPoolAllocator.h>
@@ -174,6 +176,7 @@ struct ContactScratch {
     std::vector<Vec3> pointsB;
     std::vector<std::pair<double, Vec3>> normals;
     std::vector<Candidate> candidates;
+    std::vector<const PairContact*> sorted;
 };
 
 /// How a mesh's face normals say which side is outside.
@@ -215,18 +218,29 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
                    const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s,
                    std::vector<MeshContact>& out) {
     out.clear();
-    const std::vector<PairContact>& pairs = result.contacts;
-    const std::size_t count = pairs.size();
+    const std::size_t count = result.contacts.size();
     if (count == 0) {
         return;
+    }
+    // The pairs in (A's triangle, B's triangle) order: the contacts depend on the set of
+    // pairs only, not on the order a query found them in (the tree's traversal order, the
+    // front's, or the mesh order of a query without tree).
+    std::vector<const PairContact*>& pairs = s.sorted;
+    pairs.clear();
+    for (const PairContact& c : result.contacts) {
+        pairs.push_back(&c);
+    }
+    auto byPair = [](const PairContact* x, const PairContact* y) { return x->pair < y->pair; };
+    if (!std::is_sorted(pairs.begin(), pairs.end(), byPair)) {
+        std::sort(pairs.begin(), pairs.end(), byPair);
     }
     s.parent.resize(count);
     std::iota(s.parent.begin(), s.parent.end(), 0);
     unionByVertex(
-        count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i].pair.a][k]; },
+        count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i]->pair.a][k]; },
         s.parent, s.byVertex);
     unionByVertex(
-        count, [&](std::size_t i, int k) { return meshB.triangles()[pairs[i].pair.b][k]; },
+        count, [&](std::size_t i, int k) { return meshB.triangles()[pairs[i]->pair.b][k]; },
         s.parent, s.byVertex);
 
     // Pairs grouped by patch (root), each group in query order.
@@ -248,7 +262,7 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         s.normals.clear();
         Vec3 sum = Vec3::Zero();
         for (std::size_t k = begin; k < end; ++k) {
-            const PairContact& c = pairs[s.order[k]];
+            const PairContact& c = *pairs[s.order[k]];
             const Index3& ia = meshA.triangles()[c.pair.a];
             const Index3& ib = meshB.triangles()[c.pair.b];
             s.verticesA.insert(s.verticesA.end(), ia.begin(), ia.end());
@@ -323,7 +337,7 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         if (!s.patches[root].valid) {
             continue;
         }
-        const TriangleIntersection& g = pairs[i].geometry;
+        const TriangleIntersection& g = pairs[i]->geometry;
         for (int k = 0; k < g.count; ++k) {
             s.candidates.push_back({g.points[k], root, std::int32_t(i)});
         }
@@ -396,8 +410,8 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         contact.point = c.point;
         contact.normal = patch.normal;
         contact.depth = patch.depth;
-        contact.triangleX = pairs[c.pair].pair.a;
-        contact.triangleY = pairs[c.pair].pair.b;
+        contact.triangleX = pairs[c.pair]->pair.a;
+        contact.triangleY = pairs[c.pair]->pair.b;
         out.push_back(contact);
     }
 }
@@ -669,6 +683,8 @@ struct MeshStep {
 };
 
 struct MeshContactAlgorithm::State {
+    explicit State(std::shared_ptr<detail::StagePlanner> planner) : stages(std::move(planner)) {}
+    detail::PairStages stages;  ///< the stage planner's decisions for this pair
     narrowphase::MeshQuery query;
     std::vector<MeshContact> contacts;
     MeshStep stepA, stepB;              ///< filled by calculateTimeOfImpact
@@ -833,6 +849,7 @@ btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
         // Rounded down: the fraction handed to Bullet stays no later than the contact.
         const btScalar toi =
             std::clamp(roundOutward(f0 + hit.toi * (f1 - f0), false), btScalar(0), btScalar(1));
+        s.stages.countTimeOfImpactHit();
         for (btCollisionObject* body : {body0, body1}) {
             if (movesOverStep(*body) && body->getHitFraction() > toi) {
                 body->setHitFraction(toi);
@@ -848,7 +865,7 @@ MeshContactAlgorithm::MeshContactAlgorithm(const btCollisionAlgorithmConstructio
                                            const btCollisionObjectWrapper* body1)
     : btActivatingCollisionAlgorithm(ci, body0, body1),
       manifold_(ci.m_manifold),
-      state_(std::make_unique<State>()) {
+      state_(std::make_unique<State>(detail::plannerOf(ci.m_dispatcher1))) {
     if (!manifold_) {
         manifold_ =
             m_dispatcher->getNewManifold(body0->getCollisionObject(), body1->getCollisionObject());
@@ -889,8 +906,11 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     if (finitePose(body0->getWorldTransform()) && finitePose(body1->getWorldTransform())) {
         const Pose poseA = toPose(body0->getWorldTransform());
         const Pose poseB = toPose(body1->getWorldTransform());
+        const QuerySettings settings =
+            state_->stages.plan(contactSettings(), shapeA->model().mesh().triangleCount(),
+                                shapeB->model().mesh().triangleCount());
         const QueryResult& result =
-            state_->query.run(shapeA->model(), poseA, shapeB->model(), poseB, contactSettings());
+            state_->query.run(shapeA->model(), poseA, shapeB->model(), poseB, settings);
         touching = result.intersecting;
         if (result.intersecting) {
             buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
@@ -899,6 +919,8 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             toWorld(state_->contacts, poseA);
             emit(state_->contacts, true, resultOut);
         }
+        state_->stages.report(detail::PairKind::kMeshMesh, result.counters,
+                              state_->contacts.size());
     }
     if (ownManifold_) {
         resultOut->refreshContactPoints();
@@ -911,7 +933,9 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
 btScalar MeshMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
                                                   btCollisionObject* body1, const btDispatcherInfo&,
                                                   btManifoldResult*) {
-    if (!exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1)) {
+    const bool slow = !exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1);
+    state_->stages.countTimeOfImpact(slow);
+    if (slow) {
         return btScalar(1);
     }
     const TriangleMesh& meshA =
@@ -953,6 +977,7 @@ void ConvexMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0
     const btCollisionObjectWrapper* convex = meshFirst_ ? body1 : body0;
     const btCollisionObjectWrapper* mesh = meshFirst_ ? body0 : body1;
     const auto* shape = static_cast<const MeshShape*>(mesh->getCollisionShape());
+    detail::plannerOf(m_dispatcher)->add(detail::StagePlanner::k_convex_mesh_queries, 1);
     resultOut->setPersistentManifold(triangles_.m_manifoldPtr);
     triangles_.setTimeStepAndCounters(shape->getMargin(), info, convex, mesh, resultOut);
     triangles_.m_manifoldPtr->setBodies(convex->getCollisionObject(), mesh->getCollisionObject());
@@ -1054,6 +1079,8 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             // A fresh model each call: the traversal front would point into the last one.
             QuerySettings settings = contactSettings();
             settings.use_front = false;
+            settings = state_->stages.plan(settings, shape->model().mesh().triangleCount(),
+                                           sceneryModel.mesh().triangleCount());
             const QueryResult& result =
                 state_->query.run(shape->model(), meshPose, sceneryModel, identity, settings);
             touching = result.intersecting;
@@ -1068,6 +1095,8 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
                 }
                 emit(state_->contacts, meshFirst_, resultOut);
             }
+            state_->stages.report(detail::PairKind::kMeshScenery, result.counters,
+                                  state_->contacts.size());
         }
     }
     if (ownManifold_) {
@@ -1080,7 +1109,9 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
 
 btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCollisionObject* body1,
                                                  const btDispatcherInfo&, btManifoldResult*) {
-    if (!exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1)) {
+    const bool slow = !exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1);
+    state_->stages.countTimeOfImpact(slow);
+    if (slow) {
         return btScalar(1);
     }
     btCollisionObject* meshObject = meshFirst_ ? body0 : body1;
@@ -1130,6 +1161,10 @@ btCollisionAlgorithm* BvhMeshAlgorithm::SwappedCreateFunc::CreateCollisionAlgori
 // ---------------------------------------------------------------------------------------
 
 void registerNarrowphase(btCollisionDispatcher* dispatcher) {
+    registerNarrowphase(dispatcher, MeshStageSettings());
+}
+
+void registerNarrowphase(btCollisionDispatcher* dispatcher, const MeshStageSettings& stages) {
     if (!dispatcher) {
         throw std::invalid_argument("kolize::registerNarrowphase: null dispatcher");
     }
@@ -1145,6 +1180,7 @@ void registerNarrowphase(btCollisionDispatcher* dispatcher) {
                 "-byte elements, kolize's algorithms need " + std::to_string(largest));
         }
     }
+    detail::setPlanner(dispatcher, stages);
     static MeshMeshAlgorithm::CreateFunc meshMesh;
     static ConvexMeshAlgorithm::CreateFunc convexMesh;
     static ConvexMeshAlgorithm::SwappedCreateFunc meshConvex;

@@ -57,6 +57,8 @@ struct QueryScratch::Impl {
     std::vector<Kdop<26>> kdop26;
     std::vector<NodePair> stack;
     std::vector<NodePair> nextFront;
+    std::vector<Triangle> directTriangles;  // B's triangles in A's frame (no-tree queries)
+    std::vector<Vec3> directLo, directHi;
 
     std::uint32_t nextStamp() {
         if (++stamp == 0) {  // wrapped: forget every old stamp once every 2^32 queries
@@ -120,7 +122,49 @@ Vec3 unitNormal(const Triangle& t) {
     return length > 0 ? Vec3(n / length) : Vec3::Zero();
 }
 
-/// Every triangle pair of a leaf pair: exact boxes, facing filter, exact test.
+/// One triangle pair: exact boxes, facing filter, exact test; records a hit under the mesh
+/// triangle indices (ia, ib). Returns false when a yes/no query must stop.
+bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& phi,
+                  const Triangle& q, const Vec3& qlo, const Vec3& qhi, std::int32_t ia,
+                  std::int32_t ib) {
+    if ((plo.array() > qhi.array()).any() || (qlo.array() > phi.array()).any()) {
+        ++c.counters.triangle_box_rejects;
+        return true;
+    }
+    if (c.settings.facing_filter) {
+        const Vec3 na = (p[1] - p[0]).cross(p[2] - p[0]);
+        const Vec3 nb = (q[1] - q[0]).cross(q[2] - q[0]);
+        if (!(nb.dot(c.settings.motion) > 0) || !(na.dot(c.settings.motion) < 0)) {
+            ++c.counters.facing_culled;
+            return true;
+        }
+    }
+    ++c.counters.triangle_tests;
+    const QueryMode mode = c.settings.mode;
+    bool hit;
+    TriangleIntersection geometry;
+    if (mode == QueryMode::kContacts) {
+        hit = triangleIntersection(p, q, geometry, &c.counters.predicates);
+    } else {
+        hit = trianglesIntersect(p, q, &c.counters.predicates);
+    }
+    if (!hit) {
+        return true;
+    }
+    const TrianglePair pair{ia, ib};
+    c.result.pairs.push_back(pair);
+    ++c.counters.pairs;
+    if (mode == QueryMode::kContacts) {
+        c.result.contacts.push_back({pair, geometry, unitNormal(p), unitNormal(q)});
+    }
+    if (mode == QueryMode::kYesNo) {
+        c.stop = true;
+        return false;
+    }
+    return true;
+}
+
+/// Every triangle pair of a leaf pair.
 template <class Node>
 void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const NodeLink& la,
               const NodeLink& lb) {
@@ -137,7 +181,6 @@ void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const 
         qhi[j] = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
     }
     const std::vector<Vec3>& va = c.a.mesh().vertices();
-    const QueryMode mode = c.settings.mode;
     for (int i = 0; i < la.count(); ++i) {
         const std::int32_t slotA = la.firstSlot() + i;
         const Index3& ti = ta.slotTriangles()[slotA];
@@ -145,38 +188,43 @@ void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const 
         const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
         const Vec3 phi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
         for (int j = 0; j < countB; ++j) {
-            if ((plo.array() > qhi[j].array()).any() || (qlo[j].array() > phi.array()).any()) {
-                ++c.counters.triangle_box_rejects;
-                continue;
+            if (!trianglePair(c, p, plo, phi, qs[j], qlo[j], qhi[j], ta.triangleOrder()[slotA],
+                              tb.triangleOrder()[lb.firstSlot() + j])) {
+                return;
             }
-            if (c.settings.facing_filter) {
-                const Vec3 na = (p[1] - p[0]).cross(p[2] - p[0]);
-                const Vec3 nb = (qs[j][1] - qs[j][0]).cross(qs[j][2] - qs[j][0]);
-                if (!(nb.dot(c.settings.motion) > 0) || !(na.dot(c.settings.motion) < 0)) {
-                    ++c.counters.facing_culled;
-                    continue;
-                }
-            }
-            ++c.counters.triangle_tests;
-            bool hit;
-            TriangleIntersection geometry;
-            if (mode == QueryMode::kContacts) {
-                hit = triangleIntersection(p, qs[j], geometry, &c.counters.predicates);
-            } else {
-                hit = trianglesIntersect(p, qs[j], &c.counters.predicates);
-            }
-            if (!hit) {
-                continue;
-            }
-            const TrianglePair pair{ta.triangleOrder()[slotA],
-                                    tb.triangleOrder()[lb.firstSlot() + j]};
-            c.result.pairs.push_back(pair);
-            ++c.counters.pairs;
-            if (mode == QueryMode::kContacts) {
-                c.result.contacts.push_back({pair, geometry, unitNormal(p), unitNormal(qs[j])});
-            }
-            if (mode == QueryMode::kYesNo) {
-                c.stop = true;
+        }
+    }
+}
+
+/// Without trees (QuerySettings::use_tree off): every triangle of A against every triangle
+/// of B, in mesh order. The same per-pair tests as leafPair, so the same pairs.
+void directPairs(Context& c) {
+    const TriangleMesh& ma = c.a.mesh();
+    const TriangleMesh& mb = c.b.mesh();
+    const std::size_t countB = mb.triangleCount();
+    std::vector<Triangle>& qs = c.scratch.directTriangles;
+    std::vector<Vec3>& qlo = c.scratch.directLo;
+    std::vector<Vec3>& qhi = c.scratch.directHi;
+    qs.resize(countB);
+    qlo.resize(countB);
+    qhi.resize(countB);
+    for (std::size_t j = 0; j < countB; ++j) {
+        const Index3& t = mb.triangles()[j];
+        for (int k = 0; k < 3; ++k) {
+            qs[j][k] = c.vertexB(t[k]);
+        }
+        qlo[j] = qs[j][0].cwiseMin(qs[j][1]).cwiseMin(qs[j][2]);
+        qhi[j] = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
+    }
+    const std::vector<Vec3>& va = ma.vertices();
+    for (std::size_t i = 0; i < ma.triangleCount(); ++i) {
+        const Index3& ti = ma.triangles()[i];
+        const Triangle p = {va[ti[0]], va[ti[1]], va[ti[2]]};
+        const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
+        const Vec3 phi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
+        for (std::size_t j = 0; j < countB; ++j) {
+            if (!trianglePair(c, p, plo, phi, qs[j], qlo[j], qhi[j], std::int32_t(i),
+                              std::int32_t(j))) {
                 return;
             }
         }
@@ -532,15 +580,23 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
               QueryCounters()};
 
     Front& front = *front_;
-    if (settings.sphere_pretest) {
+    if (settings.sphere_pretest && settings.object_spheres) {
         ++c.counters.object_sphere_tests;
         const Vec3 cb = detail::applyFixedOrder(c.rotation, c.translation, b.sphere().center);
         if (detail::spheresDisjoint(cb - a.sphere().center, a.sphere().radius, b.sphere().radius,
                                     slack)) {
+            ++c.counters.object_sphere_rejects;
             resetFront();
             result_.counters = c.counters;
             return result_;
         }
+    }
+    if (!settings.use_tree) {
+        resetFront();  // a later tree query must start from the roots
+        directPairs(c);
+        result_.counters = c.counters;
+        result_.intersecting = !result_.pairs.empty();
+        return result_;
     }
     const bool recordFront = settings.use_front && settings.mode != QueryMode::kYesNo;
     const void* nodesA = nullptr;

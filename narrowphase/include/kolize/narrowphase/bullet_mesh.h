@@ -31,6 +31,8 @@
 /// the box is tilted so that only a corner or an edge goes in (where the weighted sum alone
 /// tilts by the side faces' share). The depth is local (v1): it sees only the touched
 /// triangles.
+/// The pairs are taken in (A's triangle, B's triangle) order, so the contacts depend on the
+/// set of pairs only (not on the order a query found them in: mesh_stages.h may skip the tree).
 /// Up to 4 points per manifold are chosen from the intersection points of every patch: the
 /// deepest, the farthest from it, then the two that maximise the spanned area (Bullet's
 /// sortCachedPoints rule). Each point carries its patch's normal and depth, and the triangle
@@ -55,6 +57,7 @@
 /// triangle it barely overlaps (Bullet's internal-edge contacts; no filter here yet).
 #include "kolize/narrowphase/mesh_model.h"
 #include "kolize/narrowphase/mesh_query.h"
+#include "kolize/narrowphase/mesh_stages.h"
 
 #include <BulletCollision/BroadphaseCollision/btCollisionAlgorithm.h>
 #include <BulletCollision/CollisionDispatch/btActivatingCollisionAlgorithm.h>
@@ -325,6 +328,13 @@ class BvhMeshAlgorithm : public MeshContactAlgorithm {
 /// std::invalid_argument for a null dispatcher, and for a configuration whose collision
 /// algorithm pool has elements smaller than these algorithms (Bullet's pool would hand out
 /// too small blocks; btDefaultCollisionConfiguration's are large enough).
+/// The stage planner (mesh_stages.h) runs with the default settings (auto everywhere).
 void registerNarrowphase(btCollisionDispatcher* dispatcher);
+/// The same with the stage planner's `stages` (mesh_stages.h). The settings and the counters
+/// (narrowphaseStages) belong to the dispatcher; registering again replaces the settings,
+/// also for its existing pairs, and zeroes the counters. Call it between steps. Throws
+/// std::invalid_argument also for settings out of range, naming the field; nothing is
+/// registered then.
+void registerNarrowphase(btCollisionDispatcher* dispatcher, const MeshStageSettings& stages);
 
 }  // namespace kolize

@@ -3,8 +3,9 @@
 /// Mesh A at pose A against mesh B at pose B: the thesis's pipeline after the broadphase.
 ///
 /// Stages (each counted in QueryCounters):
-///  1. object bounding spheres (optional, `sphere_pretest`);
-///  2. tree against tree: an iterative traversal of the two bounding-volume trees, node
+///  1. object bounding spheres (optional, `sphere_pretest` and `object_spheres`);
+///  2. tree against tree (or, `use_tree` off, every triangle pair directly): an iterative traversal
+///  of the two bounding-volume trees, node
 ///     pairs tested with the kind's overlap test (OBB: a node-sphere test first, when
 ///     `sphere_pretest`, then the 15-axis separating-axis test);
 ///  3. leaf pairs: B's leaf vertices transformed into A's frame (once per query, cached),
@@ -56,6 +57,18 @@ struct QuerySettings {
     /// node pair's box test. Default on: spheres reject most apart and near node pairs at
     /// a quarter of a box test's cost.
     bool sphere_pretest = true;
+    /// Stage 1 alone: off skips the object bounding spheres (the node-sphere tests stay as
+    /// `sphere_pretest` says). The test runs when both this and `sphere_pretest` are on.
+    /// Same answer either way; off saves the test where the spheres always overlap (a
+    /// resting pair), at the cost of a traversal start for pairs they would have rejected.
+    bool object_spheres = true;
+    /// Stage 2: off tests every triangle of A against every triangle of B directly (exact
+    /// boxes, then the exact test), without the trees: O(|A| |B|), for tiny meshes, where
+    /// the tree's node tests cost more than they save. Same pairs as the tree path (the
+    /// same per-pair tests on the same doubles), in mesh order (A's triangle, then B's)
+    /// instead of traversal order; the counters of stage 2 stay 0. A query without tree
+    /// forgets the traversal front.
+    bool use_tree = true;
     Descent descent = Descent::kBoth;
     /// Restart the traversal from the previous query's front (the node pairs where it
     /// stopped) when the models and the descent rule are the same; same answer, fewer
@@ -95,7 +108,8 @@ struct PairContact {
 /// Work done by one query, per stage.
 struct QueryCounters {
     std::uint64_t object_sphere_tests = 0;
-    std::uint64_t node_sphere_tests = 0;  ///< OBB trees with sphere_pretest
+    std::uint64_t object_sphere_rejects = 0;  ///< 1 when the query ended at the object spheres
+    std::uint64_t node_sphere_tests = 0;      ///< OBB trees with sphere_pretest
     std::uint64_t node_sphere_rejects = 0;
     std::uint64_t bv_tests = 0;  ///< node-pair volume tests (spheres for sphere trees)
     std::uint64_t bv_rejects = 0;
