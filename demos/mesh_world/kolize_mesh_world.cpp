@@ -14,6 +14,8 @@
 #include <kolize/engine/statistics.h>
 #include <kolize/engine/world_scene.h>
 #include <kolize/kolize.h>
+#include <kolize/narrowphase/bullet_mesh.h>
+#include <kolize/narrowphase/mesh_stages.h>
 
 #include <btBulletDynamicsCommon.h>
 
@@ -32,7 +34,8 @@ namespace {
 const char* const kUsage =
     "usage: kolize-mesh-world [options]\n"
     "  --scene LIST        mesh-world scenes, comma separated, or all (default all)\n"
-    "  --method LIST       kolize, gimpact-0, gimpact (default all three)\n"
+    "  --method LIST       kolize (its stage planner deciding), kolize-all-on (every stage\n"
+    "                      forced on), gimpact-0, gimpact (default all four)\n"
     "  --frames N          frames per run (default 180)\n"
     "  --n N               objects (default: the scene's)\n"
     "  --timestep T        seconds per frame, e.g. 1/120 (default 1/60)\n"
@@ -50,7 +53,7 @@ const char* const kUsage =
 
 struct Options {
     std::vector<std::string> scenes;
-    std::vector<std::string> methods = {"kolize", "gimpact-0", "gimpact"};
+    std::vector<std::string> methods = {"kolize", "kolize-all-on", "gimpact-0", "gimpact"};
     int frames = 180;
     int auditEvery = 5;
     std::string broadphase = "sweep";
@@ -106,7 +109,8 @@ Options parse(int argc, char** argv) {
         if (flag == "--scene") {
             options.scenes = chosen(flag, value, meshWorldScenes());
         } else if (flag == "--method") {
-            options.methods = chosen(flag, value, {"kolize", "gimpact-0", "gimpact"});
+            options.methods =
+                chosen(flag, value, {"kolize", "kolize-all-on", "gimpact-0", "gimpact"});
         } else if (flag == "--frames") {
             options.frames = int(kolize::demo::wholeNumber(flag, value, 1, 1000000, fail));
         } else if (flag == "--n") {
@@ -217,7 +221,8 @@ int main(int argc, char** argv) {
         std::vector<Run> runs;
         for (const std::string& method : options.methods) {
             kolize::SceneOptions sceneOptions = options.scene;
-            sceneOptions.meshMethod = method;
+            const bool allOn = method == "kolize-all-on";
+            sceneOptions.meshMethod = allOn ? "kolize" : method;
             Run run;
             run.method = method;
             run.scene = kolize::makeScene(
@@ -226,6 +231,10 @@ int main(int argc, char** argv) {
                                        kolize::broadphaseSettingsFor(info, sceneOptions)),
                 sceneOptions);
             run.world = static_cast<kolize::WorldScene*>(run.scene.get());
+            if (allOn) {
+                kolize::registerNarrowphase(&run.world->dispatcher(),
+                                            kolize::MeshStageSettings::allOn());
+            }
             const kolize::SceneState state = run.scene->state();
             run.initialEnergy = state.kineticEnergy + state.potentialEnergy;
             runs.push_back(std::move(run));
@@ -236,7 +245,7 @@ int main(int argc, char** argv) {
                 stepOnce(runs[(k + std::size_t(frame)) % runs.size()], audit);
             }
         }
-        std::printf("%-10s %8s %9s %9s %9s %8s %9s %10s %7s %4s %7s %6s %8s %7s %10s\n", "method",
+        std::printf("%-13s %8s %9s %9s %9s %8s %9s %10s %7s %4s %7s %6s %8s %7s %10s\n", "method",
                     "step ms", "narrow ms", "narr mean", "integr ms", "contacts", "deepest",
                     "energy+ J", "escaped", "NaN", "audited", "inters", "invented", "missing",
                     "false dep");
@@ -246,7 +255,7 @@ int main(int argc, char** argv) {
                          integrate = kolize::median(run.integrateMs),
                          contacts = kolize::median(run.contacts);
             std::printf(
-                "%-10s %8.3f %9.3f %9.3f %9.3f %8.0f %9.2e %10.3g %7d %4d %7d %6d %8d %7d %10.2e\n",
+                "%-13s %8.3f %9.3f %9.3f %9.3f %8.0f %9.2e %10.3g %7d %4d %7d %6d %8d %7d %10.2e\n",
                 run.method.c_str(), step, narrow, narrowMean, integrate, contacts, run.deepest,
                 run.energyGain, run.escaped, run.nonFinite, run.audit.pairs, run.audit.intersecting,
                 run.audit.invented, run.audit.missing, run.audit.maxFalseDepth);
@@ -264,8 +273,19 @@ int main(int argc, char** argv) {
         }
         const auto kolizeRun = std::find_if(runs.begin(), runs.end(),
                                             [](const Run& run) { return run.method == "kolize"; });
+        if (kolizeRun != runs.end()) {
+            std::printf(
+                "kolize's stages (its stage planner, summed over the frames):\n%s",
+                kolize::describeStages(kolize::narrowphaseStages(&kolizeRun->world->dispatcher()))
+                    .c_str());
+        }
         for (const Run& run : runs) {
-            if (kolizeRun != runs.end() && run.method != "kolize") {
+            if (kolizeRun != runs.end() && run.method == "kolize-all-on") {
+                std::printf(
+                    "stage planner: narrowphase %.1f%% faster than every stage on "
+                    "(mean per frame)\n",
+                    100 * (1 - mean(kolizeRun->narrowMs) / std::max(1e-9, mean(run.narrowMs))));
+            } else if (kolizeRun != runs.end() && run.method != "kolize") {
                 std::printf("narrowphase time per frame (mean), kolize / %s: %.2f\n",
                             run.method.c_str(),
                             mean(kolizeRun->narrowMs) / std::max(1e-9, mean(run.narrowMs)));

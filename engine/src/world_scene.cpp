@@ -1,5 +1,7 @@
 #include <kolize/engine/world_scene.h>
 
+#include <kolize/narrowphase/mesh_stages.h>
+
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -76,6 +78,7 @@ WorldScene::WorldScene(SceneInfo info, std::unique_ptr<btBroadphaseInterface> br
 
 WorldScene::~WorldScene() {
     world_->setAfterNarrowphase(nullptr);
+    releaseNarrowphaseStages(dispatcher_.get());  // the stage planner's entry, if any
     for (const std::unique_ptr<btTypedConstraint>& constraint : constraints_) {
         world_->removeConstraint(constraint.get());
     }
