@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
                      "scene,method,frames,timestep,substeps,ccd,step_ms,narrow_ms,narrow_mean_ms,"
                      "integrate_ms,"
                      "contacts,deepest_m,energy_gain_j,escaped,nonfinite,audited_pairs,"
-                     "intersecting,invented,missing,max_false_depth_m\n");
+                     "intersecting,invented,missing,max_false_depth_m,rounding_ties\n");
     }
     std::printf(
         "kolize-mesh-world: Bullet %d, %s precision, broadphase %s, seed %u, %d frames of %.5g s "
@@ -263,12 +263,12 @@ int main(int argc, char** argv) {
                 std::fprintf(
                     csv,
                     "%s,%s,%d,%.8g,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%d,"
-                    "%d,%.6g\n",
+                    "%d,%.6g,%d\n",
                     sceneName.c_str(), run.method.c_str(), options.frames, options.scene.timeStep,
                     options.scene.substeps, run.world->world()->meshCcd() ? 1 : 0, step, narrow,
                     narrowMean, integrate, contacts, run.deepest, run.energyGain, run.escaped,
                     run.nonFinite, run.audit.pairs, run.audit.intersecting, run.audit.invented,
-                    run.audit.missing, run.audit.maxFalseDepth);
+                    run.audit.missing, run.audit.maxFalseDepth, run.audit.roundingTies);
             }
         }
         const auto kolizeRun = std::find_if(runs.begin(), runs.end(),

@@ -29,6 +29,9 @@ struct ContactAudit {
     /// Intersecting pairs without a manifold point (none at all, or none closer than
     /// kInventedDepth): a contact that is there and was not reported.
     int missing = 0;
+    /// Pairs whose claim disagreed with one order of the exact test and agreed with the other
+    /// (touching at the rounding's scale): neither invented nor missing.
+    int roundingTies = 0;
     double maxFalseDepth = 0;  ///< deepest claimed penetration among the invented pairs (m)
     int steps = 0;             ///< audited steps
     ContactAudit& operator+=(const ContactAudit& other);
@@ -39,7 +42,11 @@ struct ContactAudit {
 constexpr double kInventedDepth = 1e-4;
 
 /// Audits `world` now (call it after the narrowphase, before the bodies move). Bodies not
-/// in `meshes` are skipped. Cost: one exact yes/no query per overlapping pair with meshes.
+/// in `meshes` are skipped. The exact test is exact on B's vertices as moved (rounded) into
+/// A's frame, so a pair counts as invented only when apart with either mesh as A, and as
+/// missing only when touching both ways (a pair touching at the rounding's scale, ~1e-16 of
+/// its size, is neither). Cost: one exact yes/no query per overlapping pair with meshes, two
+/// for a pair whose claim disagrees with the first.
 ContactAudit auditContacts(const btCollisionWorld& world, const ExactMeshes& meshes);
 
 }  // namespace kolize
