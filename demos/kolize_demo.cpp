@@ -15,6 +15,7 @@
 #include <kolize/engine/world_scene.h>
 #include <kolize/broadphase/bullet_adapter.h>
 #include <kolize/kolize.h>
+#include <kolize/narrowphase/mesh_stages.h>
 
 #include <btBulletDynamicsCommon.h>
 
@@ -334,6 +335,7 @@ struct RunResult {
     Record record;
     std::vector<btVector3> finalPositions;
     std::vector<std::uint64_t> hashes;  ///< per frame, with --determinism
+    std::string stages;  ///< mesh-world scenes with kolize's narrowphase: describeStages
 };
 
 /// What the demo assembled for a scene, and why.
@@ -459,6 +461,10 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
             }
         }
         result.finalPositions = scene->positions();
+        if (auto* world = dynamic_cast<kolize::WorldScene*>(scene.get());
+            world != nullptr && info.group == "mesh-world" && sceneOptions.meshMethod == "kolize") {
+            result.stages = kolize::describeStages(kolize::narrowphaseStages(&world->dispatcher()));
+        }
         // What the broadphase used: for "auto", the core it chose last and why.
         const auto* adapter = dynamic_cast<const kolize::BroadphaseAdapter*>(&scene->broadphase());
         r.text("core", adapter != nullptr ? adapter->coreDescription() : name);
@@ -782,8 +788,12 @@ int main(int argc, char** argv) {
         kolize::SceneOptions referenceOptions = options.scene;
         referenceOptions.substeps *= options.referenceSubsteps;
         std::vector<Record> rows;
+        std::string stages;
         for (const std::string& name : options.broadphases) {
             RunResult run = runScene(sceneName, name, options.scene, options, nullptr, determinism);
+            if (stages.empty()) {
+                stages = run.stages;
+            }
             if (drift && run.record["status"] == "ok") {
                 const RunResult fine =
                     runScene(sceneName, name, referenceOptions, options, nullptr, false);
@@ -813,6 +823,12 @@ int main(int argc, char** argv) {
                           options.scene.motion.c_str());
         }
         printTable(title, rows, info.needs, drift, determinism);
+        if (!stages.empty()) {
+            std::printf(
+                "narrowphase stages (kolize's stage planner, %s's run; "
+                "kolize-mesh-world compares it with every stage forced on):\n%s",
+                options.broadphases.front().c_str(), stages.c_str());
+        }
         all.insert(all.end(), rows.begin(), rows.end());
         if (options.replayCheck && !stream.events.empty()) {
             const std::vector<Record> replayed = replayRecords(
