@@ -90,37 +90,10 @@ struct Options {
     std::string record, replay, csv, json;
 };
 
-std::vector<std::string> list(const std::string& text) {
-    std::vector<std::string> out;
-    std::stringstream stream(text);
-    for (std::string item; std::getline(stream, item, ',');) {
-        out.push_back(item);
-    }
-    return out;
-}
-
 std::vector<std::string> sceneNames() {
     std::vector<std::string> out;
     for (const kolize::SceneInfo& info : kolize::sceneList()) {
         out.push_back(info.name);
-    }
-    return out;
-}
-
-std::vector<std::string> chosen(const std::string& flag, const std::string& text,
-                                const std::vector<std::string>& valid,
-                                const std::string& validText) {
-    if (text == "all") {
-        return valid;
-    }
-    std::vector<std::string> out = list(text);
-    if (out.empty()) {
-        fail(flag + " needs at least one name");
-    }
-    for (const std::string& name : out) {
-        if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
-            fail(flag + ": unknown name '" + name + "'; valid: all, " + validText);
-        }
     }
     return out;
 }
@@ -159,10 +132,10 @@ Options parse(int argc, char** argv) {
         }
         const std::string value = argv[++i];
         if (flag == "--scene") {
-            options.scenes = chosen(flag, value, sceneNames(), kolize::sceneNameList());
+            options.scenes = kolize::demo::chosen(flag, value, sceneNames(), fail);
         } else if (flag == "--broadphase") {
             options.broadphases =
-                chosen(flag, value, kolize::broadphaseNames(), kolize::broadphaseNameList());
+                kolize::demo::chosen(flag, value, kolize::broadphaseNames(), fail);
         } else if (flag == "--n") {
             options.scene.objects = int(kolize::demo::wholeNumber(flag, value, 1, 10000000, fail));
         } else if (flag == "--frames") {

@@ -1,9 +1,13 @@
 #pragma once
-// Command-line values shared by the demos: whole numbers in a range and times in seconds,
-// each refused with a one-line message through the program's `fail`.
+// Command-line values shared by the demos: whole numbers in a range, times in seconds and
+// lists of names, each refused with a one-line message through the program's `fail`.
 
+#include "split.h"
+
+#include <algorithm>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 namespace kolize::demo {
 
@@ -34,6 +38,29 @@ inline double seconds(const std::string& flag, const std::string& text, Fail fai
         fail(flag + " needs a time in seconds in (0, 10], e.g. 0.01 or 1/60, got '" + text + "'");
     }
     return value;
+}
+
+/// "all" -> `valid`; else the comma-separated names of `text`, each of which must be in
+/// `valid` (fail(...) naming the flag, the name and the valid ones otherwise).
+inline std::vector<std::string> chosen(const std::string& flag, const std::string& text,
+                                       const std::vector<std::string>& valid, Fail fail) {
+    if (text == "all") {
+        return valid;
+    }
+    const std::vector<std::string> out = split(text, ',');
+    if (out.empty()) {
+        fail(flag + " needs at least one name");
+    }
+    for (const std::string& name : out) {
+        if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
+            std::string names;
+            for (const std::string& v : valid) {
+                names += (names.empty() ? "" : ", ") + v;
+            }
+            fail(flag + ": unknown name '" + name + "'; valid: all, " + names);
+        }
+    }
+    return out;
 }
 
 }  // namespace kolize::demo

@@ -71,27 +71,6 @@ std::vector<std::string> meshWorldScenes() {
     return out;
 }
 
-std::vector<std::string> chosen(const std::string& flag, const std::string& text,
-                                const std::vector<std::string>& valid) {
-    if (text == "all") {
-        return valid;
-    }
-    const std::vector<std::string> out = kolize::demo::split(text, ',');
-    if (out.empty()) {
-        fail(flag + " needs at least one name");
-    }
-    for (const std::string& name : out) {
-        if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
-            std::string names;
-            for (const std::string& v : valid) {
-                names += (names.empty() ? "" : ", ") + v;
-            }
-            fail(flag + ": unknown name '" + name + "'; valid: all, " + names);
-        }
-    }
-    return out;
-}
-
 Options parse(int argc, char** argv) {
     Options options;
     options.scenes = meshWorldScenes();
@@ -107,10 +86,10 @@ Options parse(int argc, char** argv) {
         }
         const std::string value = argv[++i];
         if (flag == "--scene") {
-            options.scenes = chosen(flag, value, meshWorldScenes());
+            options.scenes = kolize::demo::chosen(flag, value, meshWorldScenes(), fail);
         } else if (flag == "--method") {
-            options.methods =
-                chosen(flag, value, {"kolize", "kolize-all-on", "gimpact-0", "gimpact"});
+            options.methods = kolize::demo::chosen(
+                flag, value, {"kolize", "kolize-all-on", "gimpact-0", "gimpact"}, fail);
         } else if (flag == "--frames") {
             options.frames = int(kolize::demo::wholeNumber(flag, value, 1, 1000000, fail));
         } else if (flag == "--n") {

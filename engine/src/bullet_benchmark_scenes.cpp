@@ -28,15 +28,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-btVector3 vec(double x, double y, double z) {
-    return btVector3(btScalar(x), btScalar(y), btScalar(z));
-}
-
-btTransform at(const btVector3& position,
-               const btQuaternion& rotation = btQuaternion::getIdentity()) {
-    return btTransform(rotation, position);
-}
-
 btQuaternion about(const btVector3& axis, double angle) {
     return btQuaternion(axis, btScalar(angle));
 }

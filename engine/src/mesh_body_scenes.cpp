@@ -52,10 +52,6 @@ MeshMethod methodOf(const SceneInfo& info, const SceneOptions& options) {
                                 options.meshMethod + "'; valid: kolize, gimpact, gimpact-0");
 }
 
-btVector3 vec(double x, double y, double z) {
-    return btVector3(btScalar(x), btScalar(y), btScalar(z));
-}
-
 /// A mesh from float coordinates (what Bullet's shapes store), so that every method and the
 /// exact check see the same vertices.
 Model modelOf(const std::string& name, const std::vector<float>& xyz,
@@ -213,15 +209,6 @@ class MeshBodies {
     MeshMethod method_;
     std::map<const MeshModel*, btCollisionShape*> shapes_;
 };
-
-btTransform at(const btVector3& position,
-               const btQuaternion& rotation = btQuaternion::getIdentity()) {
-    return btTransform(rotation, position);
-}
-
-double uniform(Rng& rng, double lo, double hi) {
-    return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
 
 /// The lowest y of the model's vertices.
 double bottomOf(const Model& model) {

@@ -6,6 +6,7 @@
 #include <kolize/engine/scene.h>
 
 #include <LinearMath/btQuaternion.h>
+#include <LinearMath/btTransform.h>
 
 #include <functional>
 #include <memory>
@@ -33,6 +34,18 @@ const std::vector<SceneEntry>& sceneEntries();
 void addWorldScenes(std::vector<SceneEntry>& entries);
 
 class WorldScene;
+
+/// Shorthands of the scene builders.
+inline btVector3 vec(double x, double y, double z) {
+    return btVector3(btScalar(x), btScalar(y), btScalar(z));
+}
+inline btTransform at(const btVector3& position,
+                      const btQuaternion& rotation = btQuaternion::getIdentity()) {
+    return btTransform(rotation, position);
+}
+inline double uniform(std::mt19937& rng, double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 
 /// A uniformly distributed rotation (a normalised 4D Gaussian sample).
 btQuaternion randomRotation(std::mt19937& rng);

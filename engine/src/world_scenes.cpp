@@ -28,19 +28,6 @@ using Rng = std::mt19937;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kFar = 1e9;  // "unbounded" side of a container
 
-btVector3 vec(double x, double y, double z) {
-    return btVector3(btScalar(x), btScalar(y), btScalar(z));
-}
-
-btTransform at(const btVector3& position,
-               const btQuaternion& rotation = btQuaternion::getIdentity()) {
-    return btTransform(rotation, position);
-}
-
-double uniform(Rng& rng, double lo, double hi) {
-    return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
 double logUniform(Rng& rng, double lo, double hi) {
     return std::exp(uniform(rng, std::log(lo), std::log(hi)));
 }
