@@ -326,8 +326,12 @@ class SweepAndPrune {
     /// Whether objects a and b overlap on every axis but `skip`, by the positions of their
     /// endpoints (the arrays' present order, which later swaps start from).
     bool overlapsOnOtherAxes(ObjectId a, ObjectId b, int skip) const {
-        const Positions& first = at_[a];
-        const Positions& second = at_[b];
+        return overlapsOnOtherAxes(at_[a], at_[b], skip);
+    }
+
+    /// Whether the intervals with endpoint positions `first` and `second` overlap on every
+    /// axis but `skip`.
+    static bool overlapsOnOtherAxes(const Positions& first, const Positions& second, int skip) {
         for (int axis = 0; axis < D; ++axis) {
             if (axis != skip && (first[2 * axis + 1] < second[2 * axis] ||
                                  second[2 * axis + 1] < first[2 * axis])) {
@@ -337,36 +341,52 @@ class SweepAndPrune {
         return true;
     }
 
-    /// Swaps the endpoint at `at` with its neighbour at `at + 1` and records a change when a
-    /// min and a max of two sorted objects pass each other.
-    void swapUp(int axis, std::uint32_t at) {
+    /// Insertion with a hole: the endpoint at `at` moves down past every endpoint it now
+    /// precedes, each of those one place up. A passed endpoint of the other kind (a min
+    /// passing a max or the reverse) is where two intervals start or stop overlapping on
+    /// this axis: recorded when the other axes overlap. The moving object's positions on the
+    /// other axes do not change meanwhile, so they are read once. Dead objects' endpoints
+    /// (removed, compacted at the next maintain()) are passed like any other; a change they
+    /// take part in is dropped by drainChanges.
+    void sortDown(int axis, std::uint32_t at) { sortAway<-1>(axis, at); }
+    /// The same upwards.
+    void sortUp(int axis, std::uint32_t at) { sortAway<+1>(axis, at); }
+
+    template <int kStep>
+    void sortAway(int axis, std::uint32_t at) {
         std::vector<Endpoint>& edges = axes_[axis];
-        const Endpoint lower = edges[at], upper = edges[at + 1];
-        const ObjectId lowerId = lower.id(), upperId = upper.id();
-        ++swaps_;
-        if (lower.isMax() != upper.isMax() && state_[lowerId] == State::Sorted &&
-            state_[upperId] == State::Sorted && overlapsOnOtherAxes(lowerId, upperId, axis)) {
-            changes_.push_back(Change{lowerId, upperId});
-            ++changesRecorded_;
+        const Endpoint moving = edges[at];
+        const ObjectId id = moving.id();
+        const bool isMax = moving.isMax();
+        const Positions mine = at_[id];
+        const std::uint32_t end = kStep > 0 ? std::uint32_t(edges.size() - 1) : 0;
+        std::size_t passed = 0;
+        while (at != end) {
+            const Endpoint next = edges[at + kStep];
+            if (!(kStep > 0 ? before(next, moving) : before(moving, next))) {
+                break;
+            }
+            const ObjectId other = next.id();
+            Positions& theirs = at_[other];
+            // Branch-free until the rare outcome: the kinds differ about half the time, at
+            // random, while a change is recorded for few swaps.
+            bool overlap = next.isMax() != isMax;
+            for (int a = 0; a < D; ++a) {
+                overlap &= a == axis ||
+                           (mine[2 * a + 1] >= theirs[2 * a]) & (theirs[2 * a + 1] >= mine[2 * a]);
+            }
+            if (overlap) {
+                changes_.push_back(Change{id, other});
+                ++changesRecorded_;
+            }
+            edges[at] = next;
+            theirs[2 * axis + (next.isMax() ? 1 : 0)] = at;
+            at += kStep;
+            ++passed;
         }
-        edges[at] = upper;
-        edges[at + 1] = lower;
-        at_[upperId][2 * axis + (upper.isMax() ? 1 : 0)] = at;
-        at_[lowerId][2 * axis + (lower.isMax() ? 1 : 0)] = at + 1;
-    }
-    void sortDown(int axis, std::uint32_t at) {
-        const std::vector<Endpoint>& edges = axes_[axis];
-        while (at > 0 && before(edges[at], edges[at - 1])) {
-            swapUp(axis, at - 1);
-            --at;
-        }
-    }
-    void sortUp(int axis, std::uint32_t at) {
-        const std::vector<Endpoint>& edges = axes_[axis];
-        while (at + 1 < edges.size() && before(edges[at + 1], edges[at])) {
-            swapUp(axis, at);
-            ++at;
-        }
+        edges[at] = moving;
+        at_[id][2 * axis + (isMax ? 1 : 0)] = at;
+        swaps_ += passed;
     }
 
     void compact() {
