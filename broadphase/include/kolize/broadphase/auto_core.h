@@ -18,12 +18,18 @@
 ///   cells and no empty ones (sweep tests every object per ray; measured on mixed-rays and
 ///   bench-raycast: spatial-hash's rays 1.08 and 0.62 ms, grid's 1.08 and 2.04, sweep's
 ///   3.09 and 3.48);
+/// - jitter (objects move, but by less than 1e-4 of their size per frame: a settling pile
+///   or pyramid): grid, whose fat boxes absorb it without a core update, while the sweep
+///   reorders every near-equal endpoint the jitter passes (pyramid, replayed: grid 1.1x of
+///   sap-noray, sweep 3.1x);
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
 ///   most Bullet worlds, resting or settling): sweep;
 /// - faster motion, and the dense grid would crowd (its cells, enlarged to fit its budget of
-///   cells per object over the objects' bounds, would put more than 4 + 2x as many other
+///   cells per object over the objects' bounds, would put more than 16 + 2x as many other
 ///   objects beside an object as the sparse cells do: a cluster in a large space, as the
-///   thesis's scene B): spatial-hash, whose cells keep their size wherever the objects are
+///   thesis's scene B with 33 at 300 objects and 340 at 3000; escape's 300 bodies flying
+///   apart have 14, where grid takes a quarter of spatial-hash's time): spatial-hash,
+///   whose cells keep their size wherever the objects are
 ///   (thesis B fast, 3000 objects: spatial-hash 0.25x of dbvt, segment-trees 0.32x, grid
 ///   1.4x, kolize-bench);
 /// - faster motion otherwise: grid.
@@ -106,9 +112,16 @@ class AutoCore {
     /// Given the scene's measure, the core it should use (the rules above, with the
     /// hysteresis); sets reason().
     Kind decide(const SceneMeasure& measure) {
+        framesSinceSwitch_ += std::size_t(measure.frames);
+        if (kind_ == Kind::Sweep) {
+            // The sweep's own cost measure: endpoint swaps per moved object since the last
+            // evaluation.
+            const double moves = measure.movedPerFrame * measure.frames;
+            swapsPerMove_ = moves > 0 ? double(sweep_.swaps() - swapsSeen_) / moves : 0;
+            swapsSeen_ = sweep_.swaps();
+        }
         const Kind wanted = rule(measure);
         ++evaluations_;
-        framesSinceSwitch_ += std::size_t(measure.frames);
         if (wanted == kind_) {
             pending_ = kind_;
             reason_ = ruleReason_;
@@ -131,6 +144,7 @@ class AutoCore {
         hash_ = SpatialHash<D, Scalar>(settings_.cells);
         trees_ = SegmentTreeSet<D, Scalar>(noKeptSet(settings_.segmentTrees));
         sweep_ = SweepAndPrune<D, Scalar>();
+        swapsSeen_ = 0;
         kind_ = kind;
         pending_ = kind;
         reason_ = why;
@@ -204,16 +218,25 @@ class AutoCore {
             return Kind::SpatialHash;
         }
         if (m.movedPerFrame < 0.5 || m.relativeMotion < 0.2) {
-            ruleReason_ = "slow motion (" + std::to_string(int(m.movedPerFrame)) +
-                          " objects moved per frame, by " + shortNumber(m.relativeMotion) +
-                          " of their size): sorted endpoints move few places";
+            const std::string motion = "slow motion (" + std::to_string(int(m.movedPerFrame)) +
+                                       " objects moved per frame, by " +
+                                       shortNumber(m.relativeMotion) + " of their size)";
+            if (m.movedPerFrame >= 0.5 && m.relativeMotion < kJitter) {
+                ruleReason_ = motion +
+                              ": jitter, which the grid's fat boxes absorb (no core "
+                              "update), while it reorders near-equal endpoints";
+                return Kind::Grid;
+            }
+            ruleReason_ = motion + ": sorted endpoints move few places (" +
+                          shortNumber(swapsPerMove_) + " swaps per moved object)";
             return Kind::Sweep;
         }
         const double sparse = sparseCell(m), dense = denseCell(m, sparse);
         const double crowdSparse = crowding(m, sparse), crowdDense = crowding(m, dense);
-        if (crowdDense > 4 + 2 * crowdSparse) {
-            ruleReason_ = "fast motion, crowded: the dense grid's cells (" + shortNumber(dense) +
-                          ") would put " + shortNumber(crowdDense) +
+        if (crowdDense > 16 + 2 * crowdSparse) {
+            ruleReason_ = "fast motion (" + shortNumber(m.relativeMotion) +
+                          " of their size per frame), crowded: the dense grid's cells (" +
+                          shortNumber(dense) + ") would put " + shortNumber(crowdDense) +
                           " others beside an object, the sparse cells (" + shortNumber(sparse) +
                           ") " + shortNumber(crowdSparse);
             return Kind::SpatialHash;
@@ -322,6 +345,10 @@ class AutoCore {
     Kind pending_ = Kind::Grid;
     std::string reason_ = "the start: no measure yet, the grid";
     std::string ruleReason_;
+    /// Motion per frame, in box sizes, under which slow motion is jitter (grid).
+    static constexpr double kJitter = 1e-4;
+    double swapsPerMove_ = 0;  ///< the sweep's swaps per moved object, last window
+    std::size_t swapsSeen_ = 0;
     std::size_t evaluations_ = 0;
     std::size_t framesSinceSwitch_ = 0;
     std::size_t switches_ = 0;
