@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -184,7 +185,10 @@ int main(int argc, char** argv) {
                      "scene,method,frames,timestep,substeps,ccd,step_ms,narrow_ms,narrow_mean_ms,"
                      "integrate_ms,"
                      "contacts,deepest_m,energy_gain_j,escaped,nonfinite,audited_pairs,"
-                     "intersecting,invented,missing,max_false_depth_m,rounding_ties\n");
+                     "intersecting,invented,missing,max_false_depth_m,rounding_ties,"
+                     "mesh_queries,convex_mesh_queries,sphere_tests,sphere_rejects,"
+                     "sphere_skipped,tree_queries,no_tree,node_tests,triangle_tests,"
+                     "intersecting_triangles,toi_calls,toi_skipped_slow,toi_hits\n");
     }
     std::printf(
         "kolize-mesh-world: Bullet %d, %s precision, broadphase %s, seed %u, %d frames of %.5g s "
@@ -242,12 +246,31 @@ int main(int argc, char** argv) {
                 std::fprintf(
                     csv,
                     "%s,%s,%d,%.8g,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%d,"
-                    "%d,%.6g,%d\n",
+                    "%d,%.6g,%d,",
                     sceneName.c_str(), run.method.c_str(), options.frames, options.scene.timeStep,
                     options.scene.substeps, run.world->world()->meshCcd() ? 1 : 0, step, narrow,
                     narrowMean, integrate, contacts, run.deepest, run.energyGain, run.escaped,
                     run.nonFinite, run.audit.pairs, run.audit.intersecting, run.audit.invented,
                     run.audit.missing, run.audit.maxFalseDepth, run.audit.roundingTies);
+                // The stage planner's counters (kolize's methods; GImpact has none: zeros).
+                kolize::MeshStageStats stages;
+                if (run.method.rfind("kolize", 0) == 0) {
+                    stages = kolize::narrowphaseStages(&run.world->dispatcher());
+                }
+                const auto count = [](std::uint64_t value) {
+                    return static_cast<unsigned long long>(value);
+                };
+                std::fprintf(
+                    csv, "%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu\n",
+                    count(stages.mesh_mesh_queries + stages.mesh_scenery_queries),
+                    count(stages.convex_mesh_queries), count(stages.object_sphere_tests),
+                    count(stages.object_sphere_rejects),
+                    count(stages.sphere_skipped_auto + stages.sphere_skipped_off),
+                    count(stages.tree_queries), count(stages.no_tree_tiny + stages.no_tree_off),
+                    count(stages.node_sphere_tests + stages.node_box_tests),
+                    count(stages.triangle_tests), count(stages.intersecting_pairs),
+                    count(stages.toi_calls), count(stages.toi_skipped_slow),
+                    count(stages.toi_hits));
             }
         }
         const auto kolizeRun = std::find_if(runs.begin(), runs.end(),

@@ -102,14 +102,15 @@ std::string sceneByBroadphase(const std::vector<std::string>& scenes,
 }
 
 /// The broadphase with the smallest `column` for `scene` in `mode`: "name (x ms)"; with a
-/// reference broadphase also its multiple of that one's. "" when none ran.
+/// reference broadphase also its multiple of that one's. "" when none ran. store-only (the
+/// floor, which finds no pairs) is not a contender.
 std::string fastest(const Csv& csv, const std::string& scene,
                     const std::vector<std::string>& broadphases, const std::string& mode,
                     const std::string& column, const std::string& reference = "") {
     std::string best;
     double bestMs = kNaN, referenceMs = kNaN;
     for (const std::string& broadphase : broadphases) {
-        const long row = find(csv, scene, broadphase, mode);
+        const long row = broadphase == "store-only" ? -1 : find(csv, scene, broadphase, mode);
         const double ms = row < 0 ? kNaN : csv.number(std::size_t(row), column);
         referenceMs = broadphase == reference ? ms : referenceMs;
         if (std::isfinite(ms) && !(ms >= bestMs)) {
