@@ -509,6 +509,11 @@ void emit(const std::vector<MeshContact>& contacts, bool xIsBody0, btManifoldRes
 
 thread_local ContactScratch contactScratch;
 
+/// One query scratch per thread for every pair's queries (a MeshQuery's own would be one per
+/// pair): B's moved nodes and vertices then reuse the same, cache-warm memory from pair to
+/// pair instead of each pair's own arrays, cold since its last query a frame ago.
+thread_local narrowphase::QueryScratch queryScratch;
+
 QuerySettings contactSettings() {
     QuerySettings settings;
     settings.mode = QueryMode::kContacts;
@@ -974,8 +979,8 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         const QuerySettings settings =
             state_->stages.plan(contactSettings(), shapeA->model().mesh().triangleCount(),
                                 shapeB->model().mesh().triangleCount());
-        const QueryResult& result =
-            state_->query.run(shapeA->model(), poseA, shapeB->model(), poseB, settings);
+        const QueryResult& result = state_->query.run(shapeA->model(), poseA, shapeB->model(),
+                                                      poseB, settings, queryScratch);
         touching = result.intersecting;
         if (result.intersecting) {
             buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
@@ -1146,8 +1151,8 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             settings.use_front = false;
             settings = state_->stages.plan(settings, shape->model().mesh().triangleCount(),
                                            sceneryModel.mesh().triangleCount());
-            const QueryResult& result =
-                state_->query.run(shape->model(), meshPose, sceneryModel, identity, settings);
+            const QueryResult& result = state_->query.run(shape->model(), meshPose, sceneryModel,
+                                                          identity, settings, queryScratch);
             touching = result.intersecting;
             if (result.intersecting) {
                 buildContacts(result, shape->model().mesh(), sceneryModel.mesh(),
