@@ -136,31 +136,47 @@ int findRoot(std::vector<int>& parent, int i) {
     return i;
 }
 
-/// Unions the pairs that share a vertex index through `vertexOf(pair, k)`.
+/// Unions the pairs that share a vertex index through `vertexOf(pair, k)`: each pair with
+/// the last one seen at each of its vertices. A root is always the smallest index of its
+/// set, so the sets and their roots do not depend on the order of the unions. `last` maps
+/// a vertex to a pair, -1 for none: all -1 on entry, and so again on return.
 template <class VertexOf>
 void unionByVertex(std::size_t pairCount, VertexOf vertexOf, std::vector<int>& parent,
-                   std::vector<std::pair<std::int32_t, int>>& scratch) {
-    scratch.clear();
+                   std::vector<int>& last) {
     for (std::size_t i = 0; i < pairCount; ++i) {
         for (int k = 0; k < 3; ++k) {
-            scratch.emplace_back(vertexOf(i, k), int(i));
+            int& seen = last[vertexOf(i, k)];
+            if (seen >= 0) {
+                const int x = findRoot(parent, seen);
+                const int y = findRoot(parent, int(i));
+                if (x != y) {
+                    parent[std::max(x, y)] = std::min(x, y);  // smallest index: deterministic
+                }
+            }
+            seen = int(i);
         }
     }
-    std::sort(scratch.begin(), scratch.end());
-    for (std::size_t i = 1; i < scratch.size(); ++i) {
-        if (scratch[i].first == scratch[i - 1].first) {
-            const int x = findRoot(parent, scratch[i].second);
-            const int y = findRoot(parent, scratch[i - 1].second);
-            if (x != y) {
-                parent[std::max(x, y)] = std::min(x, y);  // smallest index: deterministic roots
-            }
+    for (std::size_t i = 0; i < pairCount; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            last[vertexOf(i, k)] = -1;
         }
     }
 }
 
-void uniqueSorted(std::vector<std::int32_t>& values) {
+/// Sorts `values` (vertex indices) and drops repeats; `marks` is all 0 on entry and return.
+void uniqueSorted(std::vector<std::int32_t>& values, std::vector<unsigned char>& marks) {
+    std::size_t kept = 0;
+    for (const std::int32_t v : values) {
+        if (marks[v] == 0) {
+            marks[v] = 1;
+            values[kept++] = v;
+        }
+    }
+    values.resize(kept);
+    for (const std::int32_t v : values) {
+        marks[v] = 0;
+    }
     std::sort(values.begin(), values.end());
-    values.erase(std::unique(values.begin(), values.end()), values.end());
 }
 
 /// Face normals tried per patch (plus the weighted sum), the heaviest first.
@@ -169,11 +185,14 @@ constexpr std::size_t kMaxNormalCandidates = 64;
 /// Scratch of contact building (reused by an algorithm across frames).
 struct ContactScratch {
     std::vector<int> parent;
-    std::vector<std::pair<std::int32_t, int>> byVertex;
+    std::vector<int> root;             // each pair's patch (its set's root)
+    std::vector<int> lastPair;         // unionByVertex's map, all -1 between calls
+    std::vector<unsigned char> marks;  // uniqueSorted's, all 0 between calls
     std::vector<int> order;
+    std::vector<int> patchStart;
     std::vector<Patch> patches;
     std::vector<std::int32_t> verticesA, verticesB;
-    std::vector<Vec3> pointsB;
+    std::vector<Vec3> pointsA, pointsB;
     std::vector<std::pair<double, Vec3>> normals;
     std::vector<Candidate> candidates;
     std::vector<const PairContact*> sorted;
@@ -236,23 +255,39 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
     }
     s.parent.resize(count);
     std::iota(s.parent.begin(), s.parent.end(), 0);
+    const std::size_t vertexCount = std::max(meshA.vertices().size(), meshB.vertices().size());
+    if (s.lastPair.size() < vertexCount) {
+        s.lastPair.resize(vertexCount, -1);
+        s.marks.resize(vertexCount, 0);
+    }
     unionByVertex(
         count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i]->pair.a][k]; },
-        s.parent, s.byVertex);
+        s.parent, s.lastPair);
     unionByVertex(
         count, [&](std::size_t i, int k) { return meshB.triangles()[pairs[i]->pair.b][k]; },
-        s.parent, s.byVertex);
+        s.parent, s.lastPair);
+    s.root.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        s.root[i] = findRoot(s.parent, int(i));
+    }
 
-    // Pairs grouped by patch (root), each group in query order.
+    // Pairs grouped by patch (root), each group in sorted order (a stable counting sort).
+    s.patchStart.assign(count + 1, 0);
+    for (std::size_t i = 0; i < count; ++i) {
+        ++s.patchStart[s.root[i] + 1];
+    }
+    for (std::size_t r = 0; r < count; ++r) {
+        s.patchStart[r + 1] += s.patchStart[r];
+    }
     s.order.resize(count);
-    std::iota(s.order.begin(), s.order.end(), 0);
-    std::stable_sort(s.order.begin(), s.order.end(),
-                     [&](int x, int y) { return findRoot(s.parent, x) < findRoot(s.parent, y); });
+    for (std::size_t i = 0; i < count; ++i) {
+        s.order[s.patchStart[s.root[i]]++] = int(i);
+    }
     s.patches.assign(count, Patch{});
     for (std::size_t begin = 0; begin < count;) {
-        const int root = findRoot(s.parent, s.order[begin]);
+        const int root = s.root[s.order[begin]];
         std::size_t end = begin;
-        while (end < count && findRoot(s.parent, s.order[end]) == root) {
+        while (end < count && s.root[s.order[end]] == root) {
             ++end;
         }
         // The patch's vertices (A's, and B's in A's frame) and its candidate normals, each
@@ -282,8 +317,8 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
                 s.normals.push_back({weight, -normalB});
             }
         }
-        uniqueSorted(s.verticesA);
-        uniqueSorted(s.verticesB);
+        uniqueSorted(s.verticesA, s.marks);
+        uniqueSorted(s.verticesB, s.marks);
         // The heaviest distinct face normals (a deep patch of a fine mesh has thousands).
         std::sort(s.normals.begin(), s.normals.end(), [](const auto& x, const auto& y) {
             if (x.first != y.first) {
@@ -302,23 +337,52 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         if (sum.norm() > 0) {
             s.normals.push_back({0.0, sum.normalized()});
         }
+        s.pointsA.clear();
+        for (std::int32_t v : s.verticesA) {
+            s.pointsA.push_back(meshA.vertices()[v]);
+        }
         s.pointsB.clear();
         for (std::int32_t v : s.verticesB) {
             s.pointsB.push_back(bInA.apply(meshB.vertices()[v]));
         }
         // The candidate along which the patch's pieces overlap least (the separating-axis
-        // idea on the touched triangles): its overlap is the depth.
+        // idea on the touched triangles): its overlap is the depth. The smaller side is
+        // scanned whole first; the other side's partial extreme already bounds the overlap
+        // from below (max and min are exact, the subtraction monotone), so a candidate stops
+        // as soon as it cannot beat the best: the values compared are those of a full scan.
         Patch& patch = s.patches[root];
         double best = std::numeric_limits<double>::infinity();
+        const bool aFirst = s.pointsA.size() <= s.pointsB.size();
         for (const auto& candidate : s.normals) {
             const Vec3& d = candidate.second;
             double highestA = -std::numeric_limits<double>::infinity();
-            for (std::int32_t v : s.verticesA) {
-                highestA = std::max(highestA, meshA.vertices()[v].dot(d));
-            }
             double lowestB = std::numeric_limits<double>::infinity();
-            for (const Vec3& q : s.pointsB) {
-                lowestB = std::min(lowestB, q.dot(d));
+            bool beaten = false;
+            if (aFirst) {
+                for (const Vec3& p : s.pointsA) {
+                    highestA = std::max(highestA, p.dot(d));
+                }
+                for (const Vec3& q : s.pointsB) {
+                    lowestB = std::min(lowestB, q.dot(d));
+                    if (highestA - lowestB >= best) {
+                        beaten = true;
+                        break;
+                    }
+                }
+            } else {
+                for (const Vec3& q : s.pointsB) {
+                    lowestB = std::min(lowestB, q.dot(d));
+                }
+                for (const Vec3& p : s.pointsA) {
+                    highestA = std::max(highestA, p.dot(d));
+                    if (highestA - lowestB >= best) {
+                        beaten = true;
+                        break;
+                    }
+                }
+            }
+            if (beaten) {
+                continue;
             }
             const double overlap = highestA - lowestB;
             if (overlap < best) {
@@ -333,7 +397,7 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
 
     s.candidates.clear();
     for (std::size_t i = 0; i < count; ++i) {
-        const int root = findRoot(s.parent, int(i));
+        const int root = s.root[i];
         if (!s.patches[root].valid) {
             continue;
         }
@@ -445,6 +509,11 @@ void emit(const std::vector<MeshContact>& contacts, bool xIsBody0, btManifoldRes
 
 thread_local ContactScratch contactScratch;
 
+/// One query scratch per thread for every pair's queries (a MeshQuery's own would be one per
+/// pair): B's moved nodes and vertices then reuse the same, cache-warm memory from pair to
+/// pair instead of each pair's own arrays, cold since its last query a frame ago.
+thread_local narrowphase::QueryScratch queryScratch;
+
 QuerySettings contactSettings() {
     QuerySettings settings;
     settings.mode = QueryMode::kContacts;
@@ -477,8 +546,9 @@ std::string formatScale(const btVector3& s) {
 std::shared_ptr<const MeshModel> makeMeshModel(TriangleMesh mesh, int leafSize) {
     narrowphase::TreeSettings settings;
     settings.kind = narrowphase::TreeKind::kObb;
-    settings.leaf_size =
-        leafSize != 0 ? leafSize : mesh.triangleCount() <= std::size_t(kSmallMesh) ? 1 : 4;
+    settings.leaf_size = leafSize != 0                                     ? leafSize
+                         : mesh.triangleCount() <= std::size_t(kSmallMesh) ? 1
+                                                                           : 4;
     return std::make_shared<const MeshModel>(std::make_shared<const TriangleMesh>(std::move(mesh)),
                                              settings);
 }
@@ -909,8 +979,8 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         const QuerySettings settings =
             state_->stages.plan(contactSettings(), shapeA->model().mesh().triangleCount(),
                                 shapeB->model().mesh().triangleCount());
-        const QueryResult& result =
-            state_->query.run(shapeA->model(), poseA, shapeB->model(), poseB, settings);
+        const QueryResult& result = state_->query.run(shapeA->model(), poseA, shapeB->model(),
+                                                      poseB, settings, queryScratch);
         touching = result.intersecting;
         if (result.intersecting) {
             buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
@@ -1081,8 +1151,8 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             settings.use_front = false;
             settings = state_->stages.plan(settings, shape->model().mesh().triangleCount(),
                                            sceneryModel.mesh().triangleCount());
-            const QueryResult& result =
-                state_->query.run(shape->model(), meshPose, sceneryModel, identity, settings);
+            const QueryResult& result = state_->query.run(shape->model(), meshPose, sceneryModel,
+                                                          identity, settings, queryScratch);
             touching = result.intersecting;
             if (result.intersecting) {
                 buildContacts(result, shape->model().mesh(), sceneryModel.mesh(),
