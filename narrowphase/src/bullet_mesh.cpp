@@ -31,6 +31,7 @@ using narrowphase::Index3;
 using narrowphase::MeshModel;
 using narrowphase::ObbNode;
 using narrowphase::ObbTree;
+using narrowphase::NearPair;
 using narrowphase::PairContact;
 using narrowphase::Pose;
 using narrowphase::QueryMode;
@@ -39,6 +40,7 @@ using narrowphase::QuerySettings;
 using narrowphase::RelativePose;
 using narrowphase::TriangleIntersection;
 using narrowphase::TriangleMesh;
+using narrowphase::TrianglePair;
 using narrowphase::Vec3;
 
 namespace {
@@ -119,7 +121,7 @@ void obbBounds(const narrowphase::Obb& box, Vec3& lo, Vec3& hi) {
 struct Candidate {
     Vec3 point;
     int patch;
-    std::int32_t pair;
+    TrianglePair ids;
 };
 
 struct Patch {
@@ -196,6 +198,7 @@ struct ContactScratch {
     std::vector<std::pair<double, Vec3>> normals;
     std::vector<Candidate> candidates;
     std::vector<const PairContact*> sorted;
+    std::vector<const NearPair*> sortedNear;
 };
 
 /// How a mesh's face normals say which side is outside.
@@ -228,6 +231,10 @@ Vec3 outward(const Vec3& n, Sides sides, const TriangleMesh& mesh, const Index3&
     return side < 0 ? Vec3(-n) : n;
 }
 
+void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
+                    const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s);
+void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out);
+
 /// Up to 4 contacts (in A's frame, X = A) from the query's pairs. `bInA` is the pose the
 /// query used: B's vertices are classified as bInA.apply(q), and so are they here. The
 /// candidate normals point from A towards B; a face normal of a mesh whose winding does not
@@ -238,9 +245,56 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
                    std::vector<MeshContact>& out) {
     out.clear();
     const std::size_t count = result.contacts.size();
-    if (count == 0) {
+    s.patches.assign(count, Patch{});
+    if (count > 0) {
+        patchesOfPairs(result, meshA, meshB, bInA, sidesA, sidesB, s);
+    }
+    // Near pairs (a contact margin): one patch each, its normal from A's closest point
+    // towards B's, its depth minus the distance; in pair order, as the intersecting pairs.
+    std::vector<const NearPair*>& near = s.sortedNear;
+    near.clear();
+    for (const NearPair& n : result.near) {
+        near.push_back(&n);
+    }
+    std::sort(near.begin(), near.end(),
+              [](const NearPair* x, const NearPair* y) { return x->pair < y->pair; });
+    for (const NearPair* n : near) {
+        Patch patch;
+        const Vec3 gap = n->on_b - n->on_a;
+        patch.valid = n->distance > 0 && gap.squaredNorm() > 0;
+        if (patch.valid) {
+            patch.normal = gap / gap.norm();
+            patch.depth = -n->distance;
+        }
+        s.patches.push_back(patch);
+    }
+    s.candidates.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+        const int root = s.root[i];
+        if (!s.patches[root].valid) {
+            continue;
+        }
+        const TriangleIntersection& g = s.sorted[i]->geometry;
+        for (int k = 0; k < g.count; ++k) {
+            s.candidates.push_back({g.points[k], root, s.sorted[i]->pair});
+        }
+    }
+    for (std::size_t j = 0; j < near.size(); ++j) {
+        if (s.patches[count + j].valid) {
+            s.candidates.push_back(
+                {0.5 * (near[j]->on_a + near[j]->on_b), int(count + j), near[j]->pair});
+        }
+    }
+    if (s.candidates.empty()) {
         return;
     }
+    chooseContacts(s, out);
+}
+
+/// The patches of the intersecting pairs (s.sorted in pair order, s.root, s.patches).
+void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
+                    const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s) {
+    const std::size_t count = result.contacts.size();
     // The pairs in (A's triangle, B's triangle) order: the contacts depend on the set of
     // pairs only, not on the order a query found them in (the tree's traversal order, the
     // front's, or the mesh order of a query without tree).
@@ -283,7 +337,6 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
     for (std::size_t i = 0; i < count; ++i) {
         s.order[s.patchStart[s.root[i]]++] = int(i);
     }
-    s.patches.assign(count, Patch{});
     for (std::size_t begin = 0; begin < count;) {
         const int root = s.root[s.order[begin]];
         std::size_t end = begin;
@@ -394,21 +447,10 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         patch.depth = patch.valid ? std::max(best, 0.0) : 0.0;
         begin = end;
     }
+}
 
-    s.candidates.clear();
-    for (std::size_t i = 0; i < count; ++i) {
-        const int root = s.root[i];
-        if (!s.patches[root].valid) {
-            continue;
-        }
-        const TriangleIntersection& g = pairs[i]->geometry;
-        for (int k = 0; k < g.count; ++k) {
-            s.candidates.push_back({g.points[k], root, std::int32_t(i)});
-        }
-    }
-    if (s.candidates.empty()) {
-        return;
-    }
+/// Up to 4 of s.candidates (not empty) as contacts.
+void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
     // Bullet's choice of 4 points: the deepest, the farthest from it, the largest triangle,
     // the largest quadrilateral (diagonal cross products, as in sortCachedPoints).
     std::array<int, 4> chosen{};
@@ -474,8 +516,8 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         contact.point = c.point;
         contact.normal = patch.normal;
         contact.depth = patch.depth;
-        contact.triangleX = pairs[c.pair]->pair.a;
-        contact.triangleY = pairs[c.pair]->pair.b;
+        contact.triangleX = c.ids.a;
+        contact.triangleY = c.ids.b;
         out.push_back(contact);
     }
 }
@@ -519,6 +561,15 @@ QuerySettings contactSettings() {
     settings.mode = QueryMode::kContacts;
     settings.use_front = true;
     return settings;
+}
+
+/// The pair's contact margin: the dispatcher's, at most the manifold's breaking threshold.
+double contactMargin(detail::PairStages& stages, const btPersistentManifold* manifold) {
+    const double margin = stages.planner().settings.contact_margin;
+    if (margin <= 0 || manifold == nullptr) {
+        return 0;
+    }
+    return std::min(margin, double(manifold->getContactBreakingThreshold()));
 }
 
 /// After refreshContactPoints, for two meshes the exact test found apart: the kept points'
@@ -976,13 +1027,14 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     if (finitePose(body0->getWorldTransform()) && finitePose(body1->getWorldTransform())) {
         const Pose poseA = toPose(body0->getWorldTransform());
         const Pose poseB = toPose(body1->getWorldTransform());
-        const QuerySettings settings =
-            state_->stages.plan(contactSettings(), shapeA->model().mesh().triangleCount(),
-                                shapeB->model().mesh().triangleCount());
+        QuerySettings base = contactSettings();
+        base.margin = contactMargin(state_->stages, manifold_);
+        const QuerySettings settings = state_->stages.plan(
+            base, shapeA->model().mesh().triangleCount(), shapeB->model().mesh().triangleCount());
         const QueryResult& result = state_->query.run(shapeA->model(), poseA, shapeB->model(),
                                                       poseB, settings, queryScratch);
         touching = result.intersecting;
-        if (result.intersecting) {
+        if (result.intersecting || !result.near.empty()) {
             buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
                           RelativePose(poseA, poseB), sidesOf(*shapeA), sidesOf(*shapeB),
                           contactScratch, state_->contacts);
@@ -1136,6 +1188,9 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             sceneryWrap->getWorldTransform().inverse() * meshWrap->getWorldTransform();
         btVector3 lo, hi;
         shape->getAabb(meshInScenery, lo, hi);
+        const double margin = contactMargin(state_->stages, manifold_);
+        lo -= btVector3(1, 1, 1) * btScalar(margin);
+        hi += btVector3(1, 1, 1) * btScalar(margin);
         SceneryCollector collector(toPose(sceneryWrap->getWorldTransform()));
         scenery->processAllTriangles(&collector, lo, hi);
         if (!collector.triangles.empty()) {
@@ -1149,12 +1204,13 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             // A fresh model each call: the traversal front would point into the last one.
             QuerySettings settings = contactSettings();
             settings.use_front = false;
+            settings.margin = margin;
             settings = state_->stages.plan(settings, shape->model().mesh().triangleCount(),
                                            sceneryModel.mesh().triangleCount());
             const QueryResult& result = state_->query.run(shape->model(), meshPose, sceneryModel,
                                                           identity, settings, queryScratch);
             touching = result.intersecting;
-            if (result.intersecting) {
+            if (result.intersecting || !result.near.empty()) {
                 buildContacts(result, shape->model().mesh(), sceneryModel.mesh(),
                               RelativePose(meshPose, identity), sidesOf(*shape), Sides::kScenery,
                               contactScratch, state_->contacts);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace kolize::narrowphase {
@@ -97,8 +98,9 @@ struct Context {
     const QuerySettings& settings;
     Eigen::Matrix3d rotation;  // B in A's frame
     Vec3 translation;
-    double slack;  // absolute position error bound (pose and centre roundings)
+    double slack;  // absolute position error bound (pose and centre roundings), plus the margin
     float slackFloat;
+    double margin;  // QuerySettings::margin in kContacts mode, else 0
     QueryScratch::Impl& scratch;
     std::uint32_t stamp;
     QueryResult& result;
@@ -146,7 +148,8 @@ class LazyNormal {
 bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& phi,
                   LazyNormal& normalP, const Triangle& q, const Vec3& qlo, const Vec3& qhi,
                   LazyNormal& normalQ, std::int32_t ia, std::int32_t ib) {
-    if ((plo.array() > qhi.array()).any() || (qlo.array() > phi.array()).any()) {
+    const double m = c.margin;  // 0 without a contact margin: the exact boxes
+    if ((plo.array() - m > qhi.array()).any() || (qlo.array() - m > phi.array()).any()) {
         ++c.counters.triangle_box_rejects;
         return true;
     }
@@ -168,6 +171,13 @@ bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& ph
         hit = trianglesIntersect(p, q, &c.counters.predicates);
     }
     if (!hit) {
+        if (c.margin > 0) {
+            const TriangleDistance d = triangleDistance(p, q);
+            if (d.distance <= c.margin) {
+                c.result.near.push_back({TrianglePair{ia, ib}, d.distance, d.on_p, d.on_q});
+                ++c.counters.near_pairs;
+            }
+        }
         return true;
     }
     const TrianglePair pair{ia, ib};
@@ -600,17 +610,31 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
     result_.intersecting = false;
     result_.pairs.clear();
     result_.contacts.clear();
+    result_.near.clear();
     QueryScratch::Impl& s = scratch.impl();
     const std::size_t vertexCount = b.mesh().vertices().size();
     if (s.vertexStamp.size() < vertexCount) {
         s.vertexStamp.resize(vertexCount, 0);
         s.vertices.resize(vertexCount);
     }
-    // Rounding of B's vertices and box centres moved into A's frame, with a wide margin.
+    if (!(settings.margin >= 0) || !std::isfinite(settings.margin)) {
+        throw std::invalid_argument(
+            "mesh query of '" + a.mesh().name() + "' and '" + b.mesh().name() +
+            "': the margin must be finite and >= 0, not " + std::to_string(settings.margin));
+    }
+    const double margin = settings.mode == QueryMode::kContacts ? settings.margin : 0.0;
+    const bool kdop =
+        a.kind() != TreeKind::kSphere && a.kind() != TreeKind::kAabb && a.kind() != TreeKind::kObb;
+    if (margin > 0 && kdop) {
+        throw std::invalid_argument("mesh query of '" + a.mesh().name() + "' and '" +
+                                    b.mesh().name() + "': k-DOP trees take no margin");
+    }
+    // Rounding of B's vertices and box centres moved into A's frame, with a wide margin;
+    // the contact margin widens every bounding-volume test by as much again.
     const double slack =
         0x1p-40 * (2 * a.mesh().coordinateBound() + 2 * b.mesh().coordinateBound() +
                    relative.translation().norm()) +
-        std::numeric_limits<double>::denorm_min();
+        std::numeric_limits<double>::denorm_min() + margin;
     Context c{a,
               b,
               settings,
@@ -618,6 +642,7 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
               relative.translation(),
               slack,
               detail::roundUp(slack),
+              margin,
               s,
               s.nextStamp(),
               result_,

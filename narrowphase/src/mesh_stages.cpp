@@ -97,6 +97,10 @@ void checkSettings(const MeshStageSettings& s) {
     if (s.tiny_pair_limit < 0) {
         refuse("tiny_pair_limit must be at least 0, not " + std::to_string(s.tiny_pair_limit));
     }
+    if (!(s.contact_margin >= 0) || !std::isfinite(s.contact_margin)) {
+        refuse("contact_margin must be finite and at least 0, not " +
+               std::to_string(s.contact_margin));
+    }
 }
 
 }  // namespace
@@ -254,6 +258,7 @@ void PairStages::report(PairKind kind, const narrowphase::QueryCounters& c, std:
     p.add(P::k_triangle_box_rejects, c.triangle_box_rejects);
     p.add(P::k_triangle_tests, c.triangle_tests);
     p.add(P::k_intersecting_pairs, c.pairs);
+    p.add(P::k_near_pairs, c.near_pairs);
     p.add(P::k_contacts, contacts);
 }
 
@@ -333,6 +338,11 @@ std::string describeStages(const MeshStageStats& s) {
     out += "triangle stage: " + n(s.triangle_tests) + " exact tests (" + n(s.triangle_box_rejects) +
            " triangle pairs rejected by their boxes), " + n(s.intersecting_pairs) +
            " intersecting pairs, " + n(s.contacts) + " contact points";
+    if (set.contact_margin > 0) {
+        char margin[64];
+        std::snprintf(margin, sizeof margin, "%g", set.contact_margin);
+        out += "; " + n(s.near_pairs) + " pairs apart within the contact margin (" + margin + " m)";
+    }
     if (s.convex_mesh_queries > 0) {
         out += "; skipped for the " + n(s.convex_mesh_queries) + " convex-mesh queries";
     }

@@ -37,6 +37,7 @@ namespace kolize::detail {
     X(triangle_box_rejects)      \
     X(triangle_tests)            \
     X(intersecting_pairs)        \
+    X(near_pairs)                \
     X(contacts)                  \
     X(toi_calls)                 \
     X(toi_skipped_slow)          \

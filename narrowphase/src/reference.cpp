@@ -85,4 +85,29 @@ std::vector<TrianglePair> allPairsReference(const TriangleMesh& a, const Pose& p
     return pairs;  // already sorted
 }
 
+std::vector<TrianglePair> referenceNearPairs(const TriangleMesh& a, const Pose& poseA,
+                                             const TriangleMesh& b, const Pose& poseB,
+                                             double margin) {
+    const std::vector<Vec3> vb = movedVertices(b, RelativePose(poseA, poseB));
+    std::vector<TrianglePair> pairs;
+    for (std::size_t i = 0; i < a.triangleCount(); ++i) {
+        const Triangle p = corners(a.vertices(), a.triangles()[i]);
+        const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
+        const Vec3 phi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
+        for (std::size_t j = 0; j < b.triangleCount(); ++j) {
+            const Triangle q = corners(vb, b.triangles()[j]);
+            const Vec3 qlo = q[0].cwiseMin(q[1]).cwiseMin(q[2]);
+            const Vec3 qhi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
+            // Farther apart than the margin along an axis: farther apart than it.
+            if (((plo - qhi).array() > margin).any() || ((qlo - phi).array() > margin).any()) {
+                continue;
+            }
+            if (!trianglesIntersect(p, q) && triangleDistance(p, q).distance <= margin) {
+                pairs.push_back({std::int32_t(i), std::int32_t(j)});
+            }
+        }
+    }
+    return pairs;  // already sorted
+}
+
 }  // namespace kolize::narrowphase

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 // Why the decision is complete. Closed triangles P and Q (non-degenerate, not coplanar)
@@ -596,6 +597,84 @@ bool triangleIntersection(const Triangle& p, const Triangle& q, TriangleIntersec
         buildGeometry(p, q, d, out);
     }
     return d.hit;
+}
+
+namespace {
+
+/// Closest points of segments [p0, p1] and [q0, q1]: minimises |P(s) - Q(t)| over the unit
+/// square, from the unconstrained minimum clamped to an edge of the square and the other
+/// parameter re-projected (a convex quadratic: one clamp and one re-projection suffice).
+/// A zero-length segment is its point; parallel segments take s = 0 first.
+void closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1,
+                       TriangleDistance& best) {
+    const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+    const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+    auto clamp01 = [](double x) { return x < 0 ? 0.0 : (x > 1 ? 1.0 : x); };
+    double s = 0, t = 0;
+    if (a > 0 || e > 0) {
+        if (a == 0) {
+            t = clamp01(f / e);
+        } else {
+            const double c = d1.dot(r);
+            if (e == 0) {
+                s = clamp01(-c / a);
+            } else {
+                const double b = d1.dot(d2);
+                const double denom = a * e - b * b;
+                s = denom > 0 ? clamp01((b * f - c * e) / denom) : 0.0;
+                t = (b * s + f) / e;
+                if (t < 0) {
+                    t = 0;
+                    s = clamp01(-c / a);
+                } else if (t > 1) {
+                    t = 1;
+                    s = clamp01((b - c) / a);
+                }
+            }
+        }
+    }
+    const Vec3 onP = p0 + s * d1, onQ = q0 + t * d2;
+    const double distance = (onQ - onP).norm();
+    if (distance < best.distance) {
+        best = {distance, onP, onQ};
+    }
+}
+
+/// Vertex v of one triangle against the face of `t` (skipped when t has no area or v's foot
+/// on t's plane lies outside t). `vOnP`: v is p's (the result's on_p), else q's.
+void closestVertexFace(const Vec3& v, const Triangle& t, bool vOnP, TriangleDistance& best) {
+    const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+    const double n2 = n.squaredNorm();
+    if (!(n2 > 0)) {
+        return;
+    }
+    for (int k = 0; k < 3; ++k) {
+        if ((t[(k + 1) % 3] - t[k]).cross(v - t[k]).dot(n) < 0) {
+            return;
+        }
+    }
+    const Vec3 foot = v - n * ((v - t[0]).dot(n) / n2);
+    const double distance = (v - foot).norm();
+    if (distance < best.distance) {
+        best = vOnP ? TriangleDistance{distance, v, foot} : TriangleDistance{distance, foot, v};
+    }
+}
+
+}  // namespace
+
+TriangleDistance triangleDistance(const Triangle& p, const Triangle& q) {
+    TriangleDistance best;
+    best.distance = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            closestOnSegments(p[i], p[(i + 1) % 3], q[j], q[(j + 1) % 3], best);
+        }
+    }
+    for (int k = 0; k < 3; ++k) {
+        closestVertexFace(p[k], q, true, best);
+        closestVertexFace(q[k], p, false, best);
+    }
+    return best;
 }
 
 }  // namespace kolize::narrowphase

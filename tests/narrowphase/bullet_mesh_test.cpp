@@ -717,6 +717,142 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
     }
 }
 
+/// The manifold points of the pair (a, b) after one collision pass.
+std::vector<btManifoldPoint> manifoldPoints(World& w, btCollisionObject* a, btCollisionObject* b) {
+    w.world.performDiscreteCollisionDetection();
+    std::vector<btManifoldPoint> out;
+    btCollisionAlgorithm* algorithm = w.algorithm(a, b);
+    if (algorithm == nullptr) {
+        return out;
+    }
+    btManifoldArray manifolds;
+    algorithm->getAllContactManifolds(manifolds);
+    for (int m = 0; m < manifolds.size(); ++m) {
+        for (int i = 0; i < manifolds[m]->getNumContacts(); ++i) {
+            out.push_back(manifolds[m]->getContactPoint(i));
+        }
+    }
+    return out;
+}
+
+// The contact margin: a box mesh hovering a known gap g above a box-mesh ground or a
+// btBvhTriangleMeshShape floor, turned and a little tilted, gets separated contacts whose
+// distances are the exact vertex heights (one of them the gap), never a penetration; none
+// beyond the margin, none without a margin, none past the manifold's breaking threshold.
+TEST(BulletMeshContacts, ContactMarginMakesSeparatedContactsNeverPenetrations) {
+    for (bool scenery : {false, true}) {
+        for (double margin : {0.0, 0.01, 1.0}) {
+            World w;
+            kolize::MeshStageSettings settings;
+            settings.contact_margin = margin;
+            kolize::registerNarrowphase(&w.dispatcher, settings);
+            std::unique_ptr<Floor> floor;
+            btRigidBody* ground = nullptr;
+            if (scenery) {
+                floor = std::make_unique<Floor>(w);
+                ground = floor->floor;
+                for (btRigidBody* box : floor->boxes) {
+                    box->getWorldTransform().setOrigin(btVector3(40, 0, 5));  // out of the way
+                }
+            } else {
+                ground = w.add(boxShape(Vec3(5, 5, 0.5)), at(0.3, 0.2, -0.5), 0);
+            }
+            btRigidBody* box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(0, 0, 5), 1);
+            for (double gap : {0.002, 0.006, 0.02, 0.05}) {
+                btTransform t = at(0.1, -0.2, 0, 0.4);
+                t.setRotation(btQuaternion(btVector3(0, 0, 1), btScalar(0.4)) *
+                              btQuaternion(btVector3(1, 0.3, 0).normalized(), btScalar(0.002)));
+                // The lowest vertex of the turned box at height `gap` above z = 0.
+                double lowest = 1e9;
+                for (const Vec3& v : boxVertices(t, Vec3::Constant(0.5))) {
+                    lowest = std::min(lowest, v.z());
+                }
+                t.setOrigin(btVector3(btScalar(0.1), btScalar(-0.2), btScalar(gap - lowest)));
+                box->setWorldTransform(t);
+                std::vector<double> heights;
+                for (const Vec3& v : boxVertices(t, Vec3::Constant(0.5))) {
+                    heights.push_back(v.z());
+                }
+                std::sort(heights.begin(), heights.end());
+                const std::vector<btManifoldPoint> points = manifoldPoints(w, ground, box);
+                const std::string where = std::string(scenery ? "scenery" : "mesh ground") +
+                                          " margin " + std::to_string(margin) + " gap " +
+                                          std::to_string(gap);
+                btPersistentManifold manifold(ground, box, 0, 0, 0);
+                const double threshold =
+                    std::min(ground->getCollisionShape()->getContactBreakingThreshold(
+                                 gContactBreakingThreshold),
+                             box->getCollisionShape()->getContactBreakingThreshold(
+                                 gContactBreakingThreshold));
+                const double reach = std::min(margin, threshold);
+                if (gap > reach) {
+                    EXPECT_TRUE(points.empty()) << where << ": " << points.size() << " points";
+                    continue;
+                }
+                ASSERT_GE(points.size(), 3u) << where;
+                double closest = 1e9;
+                for (const btManifoldPoint& p : points) {
+                    const double d = p.getDistance();
+                    closest = std::min(closest, d);
+                    EXPECT_GT(d, 0) << where << ": a penetration between meshes apart";
+                    EXPECT_LE(d, reach + 1e-6) << where;
+                    EXPECT_NEAR(std::fabs(p.m_normalWorldOnB.z()), 1, 1e-6) << where;
+                    // Each point is a box vertex over the ground: its distance is one of the
+                    // bottom vertices' heights.
+                    double nearest = 1e9;
+                    for (int k = 0; k < 4; ++k) {
+                        nearest = std::min(nearest, std::fabs(heights[k] - d));
+                    }
+                    EXPECT_LT(nearest, 1e-6) << where << " distance " << d;
+                }
+                EXPECT_NEAR(closest, gap, 1e-6) << where;
+            }
+        }
+    }
+}
+
+TEST(BulletMeshContacts, ContactMarginCatchesALandingBoxBeforeItSinksIn) {
+    // A box mesh dropped 1 cm onto a box-mesh ground (0.45 m/s at landing, 7.5 mm per step):
+    // without a margin the exact contacts respond once it is in; with 1 cm of margin the
+    // separated contacts stop it at the surface.
+    double lowest[2] = {1e9, 1e9}, rest[2] = {0, 0};
+    std::uint64_t near[2] = {0, 0};
+    for (int run = 0; run < 2; ++run) {
+        World w;
+        kolize::MeshStageSettings settings;
+        settings.contact_margin = run == 0 ? 0.0 : 0.01;
+        kolize::registerNarrowphase(&w.dispatcher, settings);
+        w.add(boxShape(Vec3(5, 5, 0.5)), at(0, 0, -0.5), 0);
+        btRigidBody* box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(0, 0, 0.51, 0.3), 1);
+        for (int step = 0; step < 240; ++step) {
+            w.world.stepSimulation(btScalar(1.0 / 60), 0);
+            lowest[run] = std::min(lowest[run], double(box->getWorldTransform().getOrigin().z()));
+        }
+        rest[run] = box->getWorldTransform().getOrigin().z();
+        EXPECT_LT(box->getLinearVelocity().length(), 0.01) << "run " << run;
+        const kolize::MeshStageStats stats = kolize::narrowphaseStages(&w.dispatcher);
+        near[run] = stats.near_pairs;
+        EXPECT_EQ(
+            kolize::describeStages(stats).find("within the contact margin") != std::string::npos,
+            run == 1);
+    }
+    EXPECT_EQ(near[0], 0u);
+    EXPECT_GT(near[1], 0u);
+    EXPECT_LT(lowest[0], 0.5 - 2e-3) << "the exact contacts alone let it in (the comparison)";
+    EXPECT_GT(lowest[1], 0.5 - 1e-3);
+    EXPECT_NEAR(rest[1], 0.5, 0.01);
+}
+
+TEST(BulletMeshContacts, BadContactMarginsAreRefused) {
+    World w;
+    kolize::MeshStageSettings settings;
+    for (double bad : {-0.01, std::nan(""), std::numeric_limits<double>::infinity()}) {
+        settings.contact_margin = bad;
+        EXPECT_THROW(kolize::registerNarrowphase(&w.dispatcher, settings), std::invalid_argument)
+            << bad;
+    }
+}
+
 TEST(BulletMeshContacts, ConvexShapesRestOnAMesh) {
     World w;
     w.add(boxShape(Vec3(5, 5, 0.5)), at(0, 0, -0.5), 0);

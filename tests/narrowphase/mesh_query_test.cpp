@@ -3,6 +3,9 @@
 #include "query_fixture.h"
 
 #include <atomic>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <cstdlib>
 #include <new>
 
@@ -239,6 +242,104 @@ TEST(MeshQuery, ContactGeometryLiesOnBothTriangles) {
             EXPECT_NEAR(c.normal_b.dot(x - tb[0]), 0.0, 1e-9);
         }
     }
+}
+
+// The contact margin: the near pairs of every tree kind that takes one, with and without
+// tree and front, are exactly the plain all-pairs reference's (referenceNearPairs), at poses
+// just apart, just inside and farther apart; the intersecting pairs stay the exact ones.
+TEST(MeshQuery, MarginReportsTheNearPairsOfTheBruteForce) {
+    const Scene& s = scene();
+    const MeshModel torusAabb(s.torus.mesh, TreeSettings{TreeKind::kAabb, 4});
+    const MeshModel sphereAabb(s.sphere.mesh, TreeSettings{TreeKind::kAabb, 4});
+    const MeshModel torusSphere(s.torus.mesh, TreeSettings{TreeKind::kSphere, 2});
+    const MeshModel sphereSphere(s.sphere.mesh, TreeSettings{TreeKind::kSphere, 2});
+    struct Kind {
+        const char* name;
+        const MeshModel& a;
+        const MeshModel& b;
+    };
+    const Kind kinds[] = {{"obb", s.torusModel, s.sphereModel},
+                          {"aabb", torusAabb, sphereAabb},
+                          {"sphere", torusSphere, sphereSphere}};
+    std::size_t nearSeen = 0, onlyNear = 0, poses = 0;
+    std::uint32_t seed = 1931;
+    for (workload::PoseClass kind :
+         {workload::PoseClass::kNear, workload::PoseClass::kShallow, workload::PoseClass::kApart}) {
+        for (const workload::WorkloadPose& p : workload::makePoses(
+                 s.torus, s.torusModel, s.sphere, s.sphereModel, kind, scaled(3), seed++)) {
+            ++poses;
+            const auto pairs = referencePairs(*s.torus.mesh, p.a, *s.sphere.mesh, p.b);
+            for (double margin : {0.004, 0.03}) {
+                const auto near =
+                    referenceNearPairs(*s.torus.mesh, p.a, *s.sphere.mesh, p.b, margin);
+                nearSeen += near.size();
+                onlyNear += pairs.empty() && !near.empty() ? 1 : 0;
+                for (const Kind& k : kinds) {
+                    for (int variant = 0; variant < 3; ++variant) {  // tree, tree twice, none
+                        if (variant == 2 && k.name != kinds[0].name) {
+                            continue;
+                        }
+                        MeshQuery query;
+                        QuerySettings settings;
+                        settings.mode = QueryMode::kContacts;
+                        settings.margin = margin;
+                        settings.use_front = variant == 1;
+                        settings.use_tree = variant != 2;
+                        const QueryResult* r = &query.run(k.a, p.a, k.b, p.b, settings);
+                        if (variant == 1) {  // the second query starts from the front
+                            r = &query.run(k.a, p.a, k.b, p.b, settings);
+                            EXPECT_TRUE(r->counters.started_from_front || near.empty());
+                        }
+                        std::vector<TrianglePair> gotPairs = r->pairs, gotNear;
+                        for (const NearPair& n : r->near) {
+                            gotNear.push_back(n.pair);
+                            EXPECT_LE(n.distance, margin);
+                            EXPECT_GE(n.distance, 0.0);
+                            EXPECT_NEAR((n.on_b - n.on_a).norm(), n.distance, 1e-12);
+                        }
+                        std::sort(gotPairs.begin(), gotPairs.end());
+                        std::sort(gotNear.begin(), gotNear.end());
+                        const std::string where =
+                            std::string(k.name) + " variant " + std::to_string(variant) +
+                            " margin " + std::to_string(margin) + " class " +
+                            workload::poseClassName(kind) + " seed " + std::to_string(seed - 1);
+                        EXPECT_EQ(gotPairs, pairs) << where;
+                        EXPECT_EQ(gotNear, near) << where;
+                        EXPECT_EQ(r->counters.near_pairs, near.size()) << where;
+                    }
+                }
+            }
+        }
+    }
+    // The sample means something: near pairs were found, also at poses without contact.
+    EXPECT_GT(nearSeen, 100u) << poses << " poses";
+    EXPECT_GT(onlyNear, 0u);
+}
+
+TEST(MeshQuery, MarginOnlyInContactsModeAndRefusedWhenBad) {
+    const Scene& s = scene();
+    const workload::WorkloadPose p = workload::makePoses(
+        s.torus, s.torusModel, s.sphere, s.sphereModel, workload::PoseClass::kNear, 1, 1941)[0];
+    MeshQuery query;
+    QuerySettings settings;
+    settings.margin = 0.05;
+    settings.mode = QueryMode::kContacts;
+    ASSERT_FALSE(query.run(s.torusModel, p.a, s.sphereModel, p.b, settings).near.empty());
+    settings.mode = QueryMode::kAllPairs;
+    EXPECT_TRUE(query.run(s.torusModel, p.a, s.sphereModel, p.b, settings).near.empty());
+    settings.mode = QueryMode::kContacts;
+    for (double bad : {-1e-9, std::nan(""), std::numeric_limits<double>::infinity()}) {
+        settings.margin = bad;
+        EXPECT_THROW(query.run(s.torusModel, p.a, s.sphereModel, p.b, settings),
+                     std::invalid_argument)
+            << bad;
+    }
+    const MeshModel torusKdop(s.torus.mesh, TreeSettings{TreeKind::kKdop14, 4});
+    const MeshModel sphereKdop(s.sphere.mesh, TreeSettings{TreeKind::kKdop14, 4});
+    settings.margin = 0.01;
+    EXPECT_THROW(query.run(torusKdop, p.a, sphereKdop, p.b, settings), std::invalid_argument);
+    settings.margin = 0;
+    EXPECT_NO_THROW(query.run(torusKdop, p.a, sphereKdop, p.b, settings));
 }
 
 }  // namespace

@@ -321,4 +321,124 @@ TEST(TriangleTest, CoplanarOverlapPolygonHasTheRightArea) {
     EXPECT_NEAR(g.measure(), 0.5, 1e-15);  // from x = 0.25 to the hypotenuse at x = 0.75
 }
 
+// triangleDistance against an independent reference: the smallest distance from a dense
+// barycentric sample of each triangle to the other (distanceToTriangle above), which is at
+// least the true distance and at most it plus the sample's spacing. Seeded families: random
+// shapes, parallel faces, coplanar apart, crossed edges, zero-area (segments, points), and
+// scales from 1e-6 to 1e6.
+TEST(TriangleDistance, MatchesADenseSampleOnDisjointPairs) {
+    const unsigned seed = 2081;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    auto point = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+    constexpr int kSteps = 60;  // sample spacing: 1/60 of an edge
+    auto sampledDistance = [&](const Triangle& p, const Triangle& q) {
+        double best = 1e300;
+        for (int side = 0; side < 2; ++side) {
+            const Triangle& from = side == 0 ? p : q;
+            const Triangle& to = side == 0 ? q : p;
+            for (int i = 0; i <= kSteps; ++i) {
+                for (int j = 0; i + j <= kSteps; ++j) {
+                    const double a = double(i) / kSteps, b = double(j) / kSteps;
+                    const Vec3 x = (1 - a - b) * from[0] + a * from[1] + b * from[2];
+                    best = std::min(best, distanceToTriangle(x, to));
+                }
+            }
+        }
+        return best;
+    };
+    auto diameter = [](const Triangle& t) {
+        return std::max({(t[0] - t[1]).norm(), (t[1] - t[2]).norm(), (t[2] - t[0]).norm()});
+    };
+    int cases = 0, families[6] = {};
+    for (int n = 0; cases < scaled(600) && n < 100000; ++n) {
+        const int family = n % 6;
+        Triangle p = {point(), point(), point()};
+        Triangle q = {point(), point(), point()};
+        const Vec3 shift = point() * 1.5;
+        switch (family) {
+            case 0:  // random, shifted
+                break;
+            case 1:  // parallel faces at a random gap
+                p = {Vec3(u(rng), u(rng), 0), Vec3(u(rng), u(rng), 0), Vec3(u(rng), u(rng), 0)};
+                q = {Vec3(u(rng), u(rng), 0.05 + 0.2 * std::abs(u(rng))), Vec3(u(rng), u(rng), 0),
+                     Vec3(u(rng), u(rng), 0)};
+                q[1].z() = q[0].z();
+                q[2].z() = q[0].z();
+                break;
+            case 2:  // coplanar, apart
+                for (Vec3& x : p) {
+                    x.z() = 0;
+                }
+                for (Vec3& x : q) {
+                    x.z() = 0;
+                }
+                break;
+            case 3:  // crossed edges (thin triangles)
+                p = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, 0.02 * u(rng), -1)};
+                q = {Vec3(0.3 * u(rng), -1, 0.05), Vec3(0.3 * u(rng), 1, 0.05),
+                     Vec3(0, 0.02 * u(rng), 1)};
+                break;
+            case 4:  // zero area: a segment against a triangle
+                p[2] = 0.5 * (p[0] + p[1]);
+                break;
+            case 5:  // zero area: a point against a segment
+                p[1] = p[2] = p[0];
+                q[2] = q[1];
+                break;
+        }
+        if (family != 1 && family != 3) {
+            for (Vec3& x : q) {
+                x += shift;
+            }
+        }
+        const double scale = std::pow(10.0, (n % 13) - 6);  // 1e-6 .. 1e6
+        for (Triangle* t : {&p, &q}) {
+            for (Vec3& x : *t) {
+                x *= scale;
+            }
+        }
+        if (trianglesIntersect(p, q)) {
+            continue;
+        }
+        ++cases;
+        ++families[family];
+        const TriangleDistance d = triangleDistance(p, q);
+        const double sampled = sampledDistance(p, q);
+        const double spacing = std::max(diameter(p), diameter(q)) / kSteps;
+        const double rounding = 1e-12 * scale;
+        SCOPED_TRACE("seed " + std::to_string(seed) + " case " + std::to_string(n) + " p " +
+                     describe(p) + " q " + describe(q));
+        EXPECT_LE(d.distance, sampled + rounding);
+        EXPECT_GE(d.distance, sampled - spacing - rounding);
+        EXPECT_NEAR((d.on_q - d.on_p).norm(), d.distance, rounding);
+        EXPECT_LE(distanceToTriangle(d.on_p, p), rounding);
+        EXPECT_LE(distanceToTriangle(d.on_q, q), rounding);
+        EXPECT_GT(d.distance, 0.0);
+    }
+    EXPECT_EQ(cases, scaled(600));
+    for (int f = 0; f < 6; ++f) {
+        EXPECT_GT(families[f], 0) << "family " << f;
+    }
+}
+
+TEST(TriangleDistance, KnownGaps) {
+    // Parallel faces 0.25 apart, overlapping in projection: vertex-face, the gap exactly.
+    const Triangle floor = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(0, 1, 0)};
+    const Triangle above = {Vec3(-0.2, 0, 0.25), Vec3(0.2, 0, 0.25), Vec3(0, 0.2, 0.25)};
+    const TriangleDistance faces = triangleDistance(floor, above);
+    EXPECT_DOUBLE_EQ(faces.distance, 0.25);
+    EXPECT_DOUBLE_EQ(faces.on_q.z() - faces.on_p.z(), 0.25);
+    // Crossed edges: x axis at z = 0 against the y axis at z = 0.5, the common normal's length.
+    const Triangle alongX = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, -1)};
+    const Triangle alongY = {Vec3(0, -1, 0.5), Vec3(0, 1, 0.5), Vec3(0, 0, 1.5)};
+    const TriangleDistance edges = triangleDistance(alongX, alongY);
+    EXPECT_DOUBLE_EQ(edges.distance, 0.5);
+    EXPECT_LE(edges.on_p.norm(), 1e-15);
+    // Two points 3-4-5 apart.
+    const Triangle a = {Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 0, 0)};
+    const Triangle b = {Vec3(3, 4, 0), Vec3(3, 4, 0), Vec3(3, 4, 0)};
+    EXPECT_DOUBLE_EQ(triangleDistance(a, b).distance, 5.0);
+}
+
 }  // namespace

@@ -17,7 +17,10 @@
 /// Contacts (mesh against mesh, and mesh against btBvhTriangleMeshShape scenery) come from
 /// the exactly intersecting triangle pairs (mesh_query.h, QueryMode::kContacts): no pair that
 /// does not touch makes a contact, so there are no ghost contacts; separated meshes make
-/// none (there is no contact margin in this version). The pairs are grouped into patches
+/// none unless a contact margin is set (MeshStageSettings::contact_margin: triangle pairs
+/// apart by at most it make separated contacts, one candidate point each, halfway between
+/// their closest points, with a positive distance and the normal along them; never a
+/// penetration). The intersecting pairs are grouped into patches
 /// (pairs whose triangles share a vertex index on either mesh). Per patch, the normal n and
 /// the depth come from a separating-axis test on the patch's own triangles: the candidate
 /// directions are their face normals (A's outward, B's reversed; outward is the winding's
@@ -33,10 +36,10 @@
 /// triangles.
 /// The pairs are taken in (A's triangle, B's triangle) order, so the contacts depend on the
 /// set of pairs only (not on the order a query found them in: mesh_stages.h may skip the tree).
-/// Up to 4 points per manifold are chosen from the intersection points of every patch: the
-/// deepest, the farthest from it, then the two that maximise the spanned area (Bullet's
-/// sortCachedPoints rule). Each point carries its patch's normal and depth, and the triangle
-/// ids of its pair through setShapeIdentifiersA/B(0, triangle) (scenery: its part and
+/// Up to 4 points per manifold are chosen from the intersection points of every patch (and the near
+/// pairs' points): the deepest, the farthest from it, then the two that maximise the spanned area
+/// (Bullet's sortCachedPoints rule). Each point carries its patch's normal and depth, and the
+/// triangle ids of its pair through setShapeIdentifiersA/B(0, triangle) (scenery: its part and
 /// triangle). The manifold is persistent: Bullet's refreshContactPoints() drops the points
 /// that moved apart, as for its own algorithms. A body at rest is mostly held by these kept
 /// points (the solver leaves it touching or a hair apart, where the exact test finds no
@@ -162,7 +165,8 @@ class MeshShape : public btConcaveShape {
 struct MeshContact {
     narrowphase::Vec3 point = narrowphase::Vec3::Zero();   ///< on the intersection curve
     narrowphase::Vec3 normal = narrowphase::Vec3::Zero();  ///< unit, from X towards Y
-    double depth = 0;                                      ///< >= 0
+    /// Penetration (>= 0); for a pair apart within the contact margin, minus its distance.
+    double depth = 0;
     std::int32_t partX = 0, triangleX = -1, partY = 0, triangleY = -1;
 };
 

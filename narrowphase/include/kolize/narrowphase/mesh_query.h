@@ -83,6 +83,14 @@ struct QuerySettings {
     /// (rotation, deep penetration); QueryCounters::facing_culled counts what it skipped.
     bool facing_filter = false;
     Vec3 motion = Vec3::Zero();
+    /// Contact margin (kContacts only; the other modes ignore it): triangle pairs that do
+    /// not intersect but are at most this far apart are reported in QueryResult::near, with
+    /// their distance and closest points. Default 0: none. The bounding-volume stages widen
+    /// every test by the margin (on top of their rounding slack), so no pair within the
+    /// margin is skipped; the distance itself is computed in double (triangleDistance), not
+    /// exactly, and a near pair is one whose computed distance is <= margin. Must be finite
+    /// and >= 0; k-DOP trees take no margin (std::invalid_argument for either).
+    double margin = 0;
 };
 
 /// One intersecting pair: triangle indices into mesh A and mesh B.
@@ -105,6 +113,15 @@ struct PairContact {
     Vec3 normal_b = Vec3::Zero();  ///< unit face normal of B's triangle in A's frame
 };
 
+/// A triangle pair within the contact margin that does not intersect (kContacts with a
+/// margin), in A's model frame.
+struct NearPair {
+    TrianglePair pair;
+    double distance = 0;       ///< > 0 up to rounding; <= the margin
+    Vec3 on_a = Vec3::Zero();  ///< closest point on A's triangle
+    Vec3 on_b = Vec3::Zero();  ///< closest point on B's triangle (in A's frame)
+};
+
 /// Work done by one query, per stage.
 struct QueryCounters {
     std::uint64_t object_sphere_tests = 0;
@@ -118,6 +135,7 @@ struct QueryCounters {
     std::uint64_t facing_culled = 0;         ///< triangle pairs skipped by the facing filter
     std::uint64_t triangle_tests = 0;        ///< exact triangle tests run
     std::uint64_t pairs = 0;                 ///< intersecting pairs found
+    std::uint64_t near_pairs = 0;            ///< pairs within the margin, apart (QueryResult::near)
     std::uint64_t vertices_transformed = 0;  ///< B's vertices moved into A's frame
     std::uint64_t front_size = 0;            ///< node pairs the traversal started from
     bool started_from_front = false;
@@ -130,6 +148,7 @@ struct QueryResult {
     /// kYesNo: the first pair found (or none); else every pair, each once, in traversal order.
     std::vector<TrianglePair> pairs;
     std::vector<PairContact> contacts;  ///< kContacts only, same order as pairs
+    std::vector<NearPair> near;         ///< kContacts with a margin: apart, within it
     QueryCounters counters;
 };
 

@@ -76,6 +76,17 @@ struct MeshStageSettings {
     /// when they touch (kolize-mesh-stages --query-sweep).
     std::int64_t tiny_pair_limit = 144;
 
+    /// Not a stage: the contact margin in metres (default 0, off; finite, >= 0). Mesh-mesh
+    /// and mesh-scenery pairs then also report triangle pairs that are apart by at most
+    /// this much (QuerySettings::margin) as separated contacts: positive distance, normal
+    /// along their closest points, never a penetration. Each pair uses at most its
+    /// manifold's contact breaking threshold (Bullet's btManifoldResult drops points farther
+    /// apart than that, and refreshContactPoints would drop them next step): about
+    /// 0.02 x a shape's bounding-sphere reach (gContactBreakingThreshold), 5 mm for a
+    /// 0.5 m mesh. The broadphase finds the pair when the bodies' boxes overlap, and
+    /// Bullet's world widens each box by the breaking threshold (updateSingleAabb).
+    double contact_margin = 0;
+
     /// Every stage forced on: the comparison run for the time the planner saves.
     static MeshStageSettings allOn();
 };
@@ -118,6 +129,7 @@ struct MeshStageStats {
     std::uint64_t triangle_box_rejects = 0;  ///< triangle pairs whose exact boxes are disjoint
     std::uint64_t triangle_tests = 0;        ///< exact triangle tests
     std::uint64_t intersecting_pairs = 0;    ///< triangle pairs found
+    std::uint64_t near_pairs = 0;            ///< apart, within the contact margin
     std::uint64_t contacts = 0;              ///< contact points handed to Bullet
 
     std::uint64_t toi_calls = 0;         ///< calculateTimeOfImpact of the mesh algorithms

@@ -44,4 +44,19 @@ struct TriangleIntersection {
 bool triangleIntersection(const Triangle& p, const Triangle& q, TriangleIntersection& out,
                           PredicateStats* stats = nullptr);
 
+/// Closest points of two triangles that do not intersect, in double (not exact).
+struct TriangleDistance {
+    double distance = 0;       ///< |on_q - on_p|
+    Vec3 on_p = Vec3::Zero();  ///< on p
+    Vec3 on_q = Vec3::Zero();  ///< on q
+};
+
+/// The distance of two triangles that do not intersect (trianglesIntersect false): the
+/// smallest of the 9 edge-edge distances and of the 6 vertex-face distances whose foot lies
+/// inside the face (one of these is always the closest pair of disjoint triangles).
+/// Degenerate triangles are their segments or points, as for trianglesIntersect. For
+/// intersecting triangles the result is that same minimum, which is not 0 in general: ask
+/// trianglesIntersect first. Cost: 9 segment-segment and 6 point-plane computations.
+TriangleDistance triangleDistance(const Triangle& p, const Triangle& q);
+
 }  // namespace kolize::narrowphase
