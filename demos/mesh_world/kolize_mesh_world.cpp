@@ -35,8 +35,10 @@ namespace {
 const char* const kUsage =
     "usage: kolize-mesh-world [options]\n"
     "  --scene LIST        mesh-world scenes, comma separated, or all (default all)\n"
-    "  --method LIST       kolize (its stage planner deciding), kolize-all-on (every stage\n"
-    "                      forced on), gimpact-0, gimpact (default all four)\n"
+    "  --method LIST       kolize (its stage planner deciding), kolize-margin (the same with\n"
+    "                      a contact margin), kolize-all-on (every stage forced on),\n"
+    "                      gimpact-0, gimpact (default all five)\n"
+    "  --contact-margin M  kolize-margin's contact margin in metres (default 0.005)\n"
     "  --frames N          frames per run (default 180)\n"
     "  --n N               objects (default: the scene's)\n"
     "  --timestep T        seconds per frame, e.g. 1/120 (default 1/60)\n"
@@ -52,9 +54,13 @@ const char* const kUsage =
     std::exit(2);
 }
 
+const std::vector<std::string> kMethods = {"kolize", "kolize-margin", "kolize-all-on", "gimpact-0",
+                                           "gimpact"};
+
 struct Options {
     std::vector<std::string> scenes;
-    std::vector<std::string> methods = {"kolize", "kolize-all-on", "gimpact-0", "gimpact"};
+    std::vector<std::string> methods = kMethods;
+    double contactMargin = 0.005;
     int frames = 180;
     int auditEvery = 5;
     std::string broadphase = "sweep";
@@ -89,8 +95,14 @@ Options parse(int argc, char** argv) {
         if (flag == "--scene") {
             options.scenes = kolize::demo::chosen(flag, value, meshWorldScenes(), fail);
         } else if (flag == "--method") {
-            options.methods = kolize::demo::chosen(
-                flag, value, {"kolize", "kolize-all-on", "gimpact-0", "gimpact"}, fail);
+            options.methods = kolize::demo::chosen(flag, value, kMethods, fail);
+        } else if (flag == "--contact-margin") {
+            char* end = nullptr;
+            options.contactMargin = std::strtod(value.c_str(), &end);
+            if (value.empty() || *end != '\0' || !(options.contactMargin >= 0) ||
+                !(options.contactMargin <= 1)) {
+                fail("--contact-margin needs metres in [0, 1], got '" + value + "'");
+            }
         } else if (flag == "--frames") {
             options.frames = int(kolize::demo::wholeNumber(flag, value, 1, 1000000, fail));
         } else if (flag == "--n") {
@@ -205,7 +217,8 @@ int main(int argc, char** argv) {
         for (const std::string& method : options.methods) {
             kolize::SceneOptions sceneOptions = options.scene;
             const bool allOn = method == "kolize-all-on";
-            sceneOptions.meshMethod = allOn ? "kolize" : method;
+            const bool margin = method == "kolize-margin";
+            sceneOptions.meshMethod = allOn || margin ? "kolize" : method;
             Run run;
             run.method = method;
             run.scene = kolize::makeScene(
@@ -217,6 +230,11 @@ int main(int argc, char** argv) {
             if (allOn) {
                 kolize::registerNarrowphase(&run.world->dispatcher(),
                                             kolize::MeshStageSettings::allOn());
+            }
+            if (margin) {
+                kolize::MeshStageSettings settings;
+                settings.contact_margin = options.contactMargin;
+                kolize::registerNarrowphase(&run.world->dispatcher(), settings);
             }
             const kolize::SceneState state = run.scene->state();
             run.initialEnergy = state.kineticEnergy + state.potentialEnergy;

@@ -29,9 +29,9 @@ namespace kolize {
 
 using narrowphase::Index3;
 using narrowphase::MeshModel;
+using narrowphase::NearPair;
 using narrowphase::ObbNode;
 using narrowphase::ObbTree;
-using narrowphase::NearPair;
 using narrowphase::PairContact;
 using narrowphase::Pose;
 using narrowphase::QueryMode;

@@ -171,11 +171,10 @@ bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& ph
         hit = trianglesIntersect(p, q, &c.counters.predicates);
     }
     if (!hit) {
-        if (c.margin > 0) {
+        if (c.margin > 0 && c.result.pairs.empty()) {  // near pairs only while apart
             const TriangleDistance d = triangleDistance(p, q);
             if (d.distance <= c.margin) {
                 c.result.near.push_back({TrianglePair{ia, ib}, d.distance, d.on_p, d.on_q});
-                ++c.counters.near_pairs;
             }
         }
         return true;
@@ -441,6 +440,17 @@ struct KdopOps {
     }
 };
 
+/// The end of a query that got past the object spheres.
+const QueryResult& finish(Context& c, QueryResult& result) {
+    result.intersecting = !result.pairs.empty();
+    if (result.intersecting) {
+        result.near.clear();  // those found before the first intersecting pair
+    }
+    c.counters.near_pairs = result.near.size();
+    result.counters = c.counters;
+    return result;
+}
+
 template <class Node, class Ops>
 void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFront) {
     const BvTree<Node>& ta = c.a.template tree<Node>();
@@ -663,9 +673,7 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
     if (!settings.use_tree) {
         resetFront();  // a later tree query must start from the roots
         directPairs(c);
-        result_.counters = c.counters;
-        result_.intersecting = !result_.pairs.empty();
-        return result_;
+        return finish(c, result_);
     }
     const bool recordFront = settings.use_front && settings.mode != QueryMode::kYesNo;
     const void* nodesA = nullptr;
@@ -737,9 +745,7 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
     } else {
         resetFront();
     }
-    result_.counters = c.counters;
-    result_.intersecting = !result_.pairs.empty();
-    return result_;
+    return finish(c, result_);
 }
 
 QueryResult meshCollide(const MeshModel& a, const Pose& poseA, const MeshModel& b,

@@ -261,7 +261,7 @@ TEST(MeshQuery, MarginReportsTheNearPairsOfTheBruteForce) {
     const Kind kinds[] = {{"obb", s.torusModel, s.sphereModel},
                           {"aabb", torusAabb, sphereAabb},
                           {"sphere", torusSphere, sphereSphere}};
-    std::size_t nearSeen = 0, onlyNear = 0, poses = 0;
+    std::size_t nearSeen = 0, onlyNear = 0, touching = 0, poses = 0;
     std::uint32_t seed = 1931;
     for (workload::PoseClass kind :
          {workload::PoseClass::kNear, workload::PoseClass::kShallow, workload::PoseClass::kApart}) {
@@ -270,10 +270,13 @@ TEST(MeshQuery, MarginReportsTheNearPairsOfTheBruteForce) {
             ++poses;
             const auto pairs = referencePairs(*s.torus.mesh, p.a, *s.sphere.mesh, p.b);
             for (double margin : {0.004, 0.03}) {
-                const auto near =
-                    referenceNearPairs(*s.torus.mesh, p.a, *s.sphere.mesh, p.b, margin);
+                // Near pairs only while no pair intersects.
+                const auto near = pairs.empty() ? referenceNearPairs(*s.torus.mesh, p.a,
+                                                                     *s.sphere.mesh, p.b, margin)
+                                                : std::vector<TrianglePair>();
                 nearSeen += near.size();
-                onlyNear += pairs.empty() && !near.empty() ? 1 : 0;
+                onlyNear += !near.empty() ? 1 : 0;
+                touching += pairs.empty() ? 0 : 1;
                 for (const Kind& k : kinds) {
                     for (int variant = 0; variant < 3; ++variant) {  // tree, tree twice, none
                         if (variant == 2 && k.name != kinds[0].name) {
@@ -311,9 +314,11 @@ TEST(MeshQuery, MarginReportsTheNearPairsOfTheBruteForce) {
             }
         }
     }
-    // The sample means something: near pairs were found, also at poses without contact.
+    // The sample means something: near pairs at poses apart, and poses that intersect (whose
+    // near pairs must be dropped).
     EXPECT_GT(nearSeen, 100u) << poses << " poses";
     EXPECT_GT(onlyNear, 0u);
+    EXPECT_GT(touching, 0u);
 }
 
 TEST(MeshQuery, MarginOnlyInContactsModeAndRefusedWhenBad) {

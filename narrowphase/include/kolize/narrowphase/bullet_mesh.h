@@ -17,13 +17,15 @@
 /// Contacts (mesh against mesh, and mesh against btBvhTriangleMeshShape scenery) come from
 /// the exactly intersecting triangle pairs (mesh_query.h, QueryMode::kContacts): no pair that
 /// does not touch makes a contact, so there are no ghost contacts; separated meshes make
-/// none unless a contact margin is set (MeshStageSettings::contact_margin: triangle pairs
-/// apart by at most it make separated contacts, one candidate point each, halfway between
-/// their closest points, with a positive distance and the normal along them; never a
-/// penetration). The intersecting pairs are grouped into patches
-/// (pairs whose triangles share a vertex index on either mesh). Per patch, the normal n and
-/// the depth come from a separating-axis test on the patch's own triangles: the candidate
-/// directions are their face normals (A's outward, B's reversed; outward is the winding's
+/// none unless a contact margin is set (MeshStageSettings::contact_margin: while the meshes
+/// are apart, triangle pairs apart by at most it make separated contacts, one candidate
+/// point each, halfway between their closest points, with a positive distance and the
+/// normal along them; never a penetration. Meshes that intersect get only the contacts of
+/// their intersecting pairs: a separated point within Bullet's breaking threshold of a
+/// penetrating one would replace it in the manifold, getCacheEntry). The intersecting pairs are
+/// grouped into patches (pairs whose triangles share a vertex index on either mesh). Per patch, the
+/// normal n and the depth come from a separating-axis test on the patch's own triangles: the
+/// candidate directions are their face normals (A's outward, B's reversed; outward is the winding's
 /// side for a closed mesh, the side away from the body's origin for an open one, and for
 /// btBvhTriangleMeshShape scenery, which is two-sided as in Bullet, the side towards the
 /// mesh body's origin: a bowl wound either way holds what falls in; the 64 with the longest

@@ -83,13 +83,15 @@ struct QuerySettings {
     /// (rotation, deep penetration); QueryCounters::facing_culled counts what it skipped.
     bool facing_filter = false;
     Vec3 motion = Vec3::Zero();
-    /// Contact margin (kContacts only; the other modes ignore it): triangle pairs that do
-    /// not intersect but are at most this far apart are reported in QueryResult::near, with
-    /// their distance and closest points. Default 0: none. The bounding-volume stages widen
-    /// every test by the margin (on top of their rounding slack), so no pair within the
-    /// margin is skipped; the distance itself is computed in double (triangleDistance), not
-    /// exactly, and a near pair is one whose computed distance is <= margin. Must be finite
-    /// and >= 0; k-DOP trees take no margin (std::invalid_argument for either).
+    /// Contact margin (kContacts only; the other modes ignore it): when no triangle pair
+    /// intersects, the pairs at most this far apart are reported in QueryResult::near, with
+    /// their distance and closest points (meshes that intersect have contacts; their near
+    /// pairs are not collected past the first intersecting pair, and dropped). Default 0. The
+    /// bounding-volume stages widen every test by the margin (on top of their rounding slack), so
+    /// no pair within the margin is skipped; the distance itself is computed in double
+    /// (triangleDistance), not exactly, and a near pair is one whose computed distance is <=
+    /// margin. Must be finite and >= 0; k-DOP trees take no margin (std::invalid_argument for
+    /// either).
     double margin = 0;
 };
 
@@ -135,7 +137,7 @@ struct QueryCounters {
     std::uint64_t facing_culled = 0;         ///< triangle pairs skipped by the facing filter
     std::uint64_t triangle_tests = 0;        ///< exact triangle tests run
     std::uint64_t pairs = 0;                 ///< intersecting pairs found
-    std::uint64_t near_pairs = 0;            ///< pairs within the margin, apart (QueryResult::near)
+    std::uint64_t near_pairs = 0;            ///< QueryResult::near's size
     std::uint64_t vertices_transformed = 0;  ///< B's vertices moved into A's frame
     std::uint64_t front_size = 0;            ///< node pairs the traversal started from
     bool started_from_front = false;
@@ -148,7 +150,7 @@ struct QueryResult {
     /// kYesNo: the first pair found (or none); else every pair, each once, in traversal order.
     std::vector<TrianglePair> pairs;
     std::vector<PairContact> contacts;  ///< kContacts only, same order as pairs
-    std::vector<NearPair> near;         ///< kContacts with a margin: apart, within it
+    std::vector<NearPair> near;         ///< kContacts with a margin, no pair intersecting
     QueryCounters counters;
 };
 

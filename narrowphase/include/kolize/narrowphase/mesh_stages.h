@@ -77,9 +77,9 @@ struct MeshStageSettings {
     std::int64_t tiny_pair_limit = 144;
 
     /// Not a stage: the contact margin in metres (default 0, off; finite, >= 0). Mesh-mesh
-    /// and mesh-scenery pairs then also report triangle pairs that are apart by at most
-    /// this much (QuerySettings::margin) as separated contacts: positive distance, normal
-    /// along their closest points, never a penetration. Each pair uses at most its
+    /// and mesh-scenery pairs that do not intersect then report their triangle pairs apart
+    /// by at most this much (QuerySettings::margin) as separated contacts: positive
+    /// distance, normal along their closest points, never a penetration. Each pair uses at most its
     /// manifold's contact breaking threshold (Bullet's btManifoldResult drops points farther
     /// apart than that, and refreshContactPoints would drop them next step): about
     /// 0.02 x a shape's bounding-sphere reach (gContactBreakingThreshold), 5 mm for a

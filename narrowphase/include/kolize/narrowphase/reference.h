@@ -23,8 +23,9 @@ std::vector<TrianglePair> referencePairs(const TriangleMesh& a, const Pose& pose
 std::vector<TrianglePair> allPairsReference(const TriangleMesh& a, const Pose& poseA,
                                             const TriangleMesh& b, const Pose& poseB);
 
-/// The pairs a query with QuerySettings::margin `margin` reports as near (QueryResult::near),
-/// sorted: every pair of triangles that do not intersect (exact test) and whose
+/// The pairs a query with QuerySettings::margin `margin` reports as near (QueryResult::near)
+/// when no pair intersects, sorted: every pair of triangles that do not intersect (exact
+/// test) and whose
 /// triangleDistance is at most `margin`, over all |a| x |b| pairs (pairs whose boxes are
 /// farther apart than the margin along an axis are skipped: they are farther apart than it).
 /// O(|a| |b|).
