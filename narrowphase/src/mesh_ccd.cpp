@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
 #include <stdexcept>
 #include <unordered_set>
@@ -29,32 +30,66 @@ struct Aabb {
     }
 };
 
-/// What a mesh contributes to the primitive tests: each vertex used by a triangle, each
-/// edge once (shared edges are tested once), each triangle.
+/// What a mesh contributes to the primitive tests, limited to what can reach the other
+/// mesh: each vertex used by a triangle, each edge once (shared edges are tested once), each
+/// triangle, whose box over the whole step (inflated by the margin) meets `reach`, the
+/// other mesh's box over the whole step (inflated). Every slice box lies in its feature's
+/// whole-step box and every slice box of the other mesh in `reach`, so a feature left out
+/// has no candidate pair in any slice: the candidate pairs are those of the whole meshes.
 struct Features {
     std::vector<int> vertices;
     std::vector<std::array<int, 2>> edges;  ///< smaller vertex index first
+    std::vector<int> triangles;             ///< indices into MovingMesh::triangles
+    std::vector<int> touched;               ///< every vertex of a kept triangle (slice boxes)
+    std::size_t left_out = 0;               ///< vertices and triangles not kept
 };
 
-Features collectFeatures(const MovingMesh& m) {
+Features collectFeatures(const MovingMesh& m, const Aabb& reach, double margin) {
     Features f;
+    auto meets = [&](Aabb box) {
+        box.lo.array() -= margin;
+        box.hi.array() += margin;
+        return box.overlaps(reach);
+    };
+    auto sweptBox = [&](std::initializer_list<int> vertices) {
+        Aabb box;
+        for (int v : vertices) {
+            box.grow(m.start[v]);
+            box.grow(m.end[v]);
+        }
+        return box;
+    };
     std::vector<char> used(m.start.size(), 0);
     std::unordered_set<uint64_t> seen;
-    for (const auto& tri : m.triangles) {
+    for (size_t t = 0; t < m.triangles.size(); ++t) {
+        const auto& tri = m.triangles[t];
+        if (!meets(sweptBox({tri[0], tri[1], tri[2]}))) {
+            ++f.left_out;
+            for (int v : tri) {
+                used[v] = used[v] == 1 ? 1 : 2;  // used by some triangle, maybe not kept
+            }
+            continue;  // nor can its edges and vertices (their boxes lie in its box)
+        }
+        f.triangles.push_back(static_cast<int>(t));
         for (int i = 0; i < 3; ++i) {
             used[tri[i]] = 1;
             const int lo = std::min(tri[i], tri[(i + 1) % 3]);
             const int hi = std::max(tri[i], tri[(i + 1) % 3]);
-            if (lo != hi &&
+            if (lo != hi && meets(sweptBox({lo, hi})) &&
                 seen.insert(static_cast<uint64_t>(lo) << 32 | static_cast<uint32_t>(hi)).second) {
                 f.edges.push_back({lo, hi});
             }
         }
     }
     for (size_t v = 0; v < used.size(); ++v) {
-        if (used[v]) {
-            f.vertices.push_back(static_cast<int>(v));
+        if (used[v] == 1) {
+            f.touched.push_back(static_cast<int>(v));
+            if (meets(sweptBox({static_cast<int>(v)}))) {
+                f.vertices.push_back(static_cast<int>(v));
+                continue;
+            }
         }
+        f.left_out += used[v] != 0 ? 1 : 0;
     }
     return f;
 }
@@ -204,9 +239,9 @@ bool facesAway(const MovingMesh& vm, int v, const MovingMesh& fm, const std::arr
 /// One mesh's features with a hierarchy per kind, and their boxes for a time slice.
 class SlicedMesh {
   public:
-    SlicedMesh(const MovingMesh& m, double margin)
+    SlicedMesh(const MovingMesh& m, double margin, const Aabb& reach)
         : mesh_(m),
-          features_(collectFeatures(m)),
+          features_(collectFeatures(m, reach, margin)),
           margin_(margin),
           vertices_(wholeStepBoxes(features_.vertices.size(),
                                    [&](size_t i, Aabb& b) { sweep(features_.vertices[i], b); })),
@@ -215,8 +250,8 @@ class SlicedMesh {
                                     sweep(features_.edges[i][0], b);
                                     sweep(features_.edges[i][1], b);
                                 })),
-          triangles_(wholeStepBoxes(m.triangles.size(), [&](size_t i, Aabb& b) {
-              for (int v : m.triangles[i]) {
+          triangles_(wholeStepBoxes(features_.triangles.size(), [&](size_t i, Aabb& b) {
+              for (int v : m.triangles[features_.triangles[i]]) {
                   sweep(v, b);
               }
           })) {
@@ -227,7 +262,7 @@ class SlicedMesh {
     /// Vertex positions at t0 and t1, and the box around them all (inflated).
     Aabb positions(double t0, double t1) {
         Aabb all;
-        for (int v : features_.vertices) {
+        for (int v : features_.touched) {
             at0_[v] = mesh_.start[v] + t0 * (mesh_.end[v] - mesh_.start[v]);
             at1_[v] = mesh_.start[v] + t1 * (mesh_.end[v] - mesh_.start[v]);
             all.grow(at0_[v]);
@@ -252,9 +287,9 @@ class SlicedMesh {
             inflate(b);
         }
         edges_.refit();
-        for (size_t i = 0; i < mesh_.triangles.size(); ++i) {
+        for (size_t i = 0; i < features_.triangles.size(); ++i) {
             Aabb& b = triangles_.leaf(i) = Aabb();
-            for (int v : mesh_.triangles[i]) {
+            for (int v : mesh_.triangles[features_.triangles[i]]) {
                 slice(v, b);
             }
             inflate(b);
@@ -342,10 +377,21 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
         }
     }
     const double margin = 8.0 * 0x1p-53 * largest + std::numeric_limits<double>::min();
-    SlicedMesh sa(a, margin), sb(b, margin);
+    auto reach = [margin](const MovingMesh& m) {  // the whole step's box, inflated
+        Aabb box;
+        for (size_t v = 0; v < m.start.size(); ++v) {
+            box.grow(m.start[v]);
+            box.grow(m.end[v]);
+        }
+        box.lo.array() -= margin;
+        box.hi.array() += margin;
+        return box;
+    };
+    SlicedMesh sa(a, margin, reach(b)), sb(b, margin, reach(a));
+    MeshContact best;
+    best.out_of_reach = sa.features().left_out + sb.features().left_out;
     const int slices = sliceCount(a, b, settings.max_time_slices);
 
-    MeshContact best;
     RobustSettings primitive = settings.primitive;
     auto consider = [&](const CcdResult& r, ContactFeatures f, std::array<int, 2> fa,
                         std::array<int, 2> fb) {
@@ -377,9 +423,10 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
         primitive.min_time = t0;
         primitive.max_time = t1;
         // Vertex of A against triangle of B, and triangle of A against vertex of B.
-        SliceBvh::overlapping(sa.vertices(), sb.triangles(), [&](int i, int tb) {
+        SliceBvh::overlapping(sa.vertices(), sb.triangles(), [&](int i, int leaf) {
             ++best.candidate_pairs;
             const int v = sa.features().vertices[i];
+            const int tb = sb.features().triangles[leaf];
             const auto& tri = b.triangles[tb];
             if (settings.cull_back_facing && facesAway(a, v, b, tri)) {
                 ++best.culled;
@@ -391,9 +438,10 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
             consider(vertexFaceRobust(q, primitive), ContactFeatures::kVertexAFaceB, {v, -1},
                      {tb, -1});
         });
-        SliceBvh::overlapping(sa.triangles(), sb.vertices(), [&](int ta, int j) {
+        SliceBvh::overlapping(sa.triangles(), sb.vertices(), [&](int leaf, int j) {
             ++best.candidate_pairs;
             const int v = sb.features().vertices[j];
+            const int ta = sa.features().triangles[leaf];
             const auto& tri = a.triangles[ta];
             if (settings.cull_back_facing && facesAway(b, v, a, tri)) {
                 ++best.culled;

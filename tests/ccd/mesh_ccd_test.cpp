@@ -238,4 +238,60 @@ TEST(CcdMesh, SlicedHierarchiesAgreeWithEveryPairOnRandomMotions) {
     EXPECT_GT(sliced, trials / 2) << "seed " << seed;
 }
 
+// The reach filter: a small octahedron flying at, past or through a large tessellated sheet
+// (200 triangles, bending a little over the step). Only the sheet's features near the
+// octahedron's sweep take part, and the earliest contact is still every pair's.
+TEST(CcdMesh, ReachFilterAgreesWithEveryPairAgainstALargeSheet) {
+    const unsigned seed = 20261203;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    auto randomVector = [&] { return Vec3(unit(rng), unit(rng), unit(rng)); };
+    const double slack = RobustSettings{}.toi_tolerance + 1e-15;
+    constexpr int kQuads = 10;
+    int hits = 0, filtered = 0;
+    const int trials = 60;
+    for (int trial = 0; trial < trials; ++trial) {
+        SCOPED_TRACE("seed " + std::to_string(seed) + ", trial " + std::to_string(trial));
+        MovingMesh sheet;
+        for (int j = 0; j <= kQuads; ++j) {
+            for (int i = 0; i <= kQuads; ++i) {
+                const Vec3 p(-4.0 + 8.0 * i / kQuads, -4.0 + 8.0 * j / kQuads, 0.0);
+                sheet.start.push_back(p);
+                sheet.end.push_back(p + Vec3(0, 0, 0.05 * unit(rng)));
+            }
+        }
+        for (int j = 0; j < kQuads; ++j) {
+            for (int i = 0; i < kQuads; ++i) {
+                const int v = j * (kQuads + 1) + i;
+                sheet.triangles.push_back({v, v + 1, v + kQuads + 2});
+                sheet.triangles.push_back({v, v + kQuads + 2, v + kQuads + 1});
+            }
+        }
+        MovingMesh a = octahedron(
+            Vec3::Zero(), 0.3,
+            Eigen::AngleAxisd(3.0 * unit(rng), randomVector().normalized()).toRotationMatrix());
+        const Vec3 from(3.0 * unit(rng), 3.0 * unit(rng), 0.2 + 1.5 * std::abs(unit(rng)));
+        const Vec3 to = from + Vec3(unit(rng), unit(rng), -2.0 * std::abs(unit(rng)));
+        for (size_t v = 0; v < a.start.size(); ++v) {
+            a.end[v] = a.start[v] + to;
+            a.start[v] += from;
+        }
+        const MeshContact reference = bruteForce(a, sheet);
+        const MeshContact got = meshCcd(a, sheet);
+        const MeshContact swapped = meshCcd(sheet, a);
+        ASSERT_EQ(got.hit, reference.hit);
+        ASSERT_EQ(swapped.hit, reference.hit);
+        if (reference.hit) {
+            EXPECT_NEAR(got.toi, reference.toi, slack);
+            EXPECT_NEAR(swapped.toi, reference.toi, slack);
+        }
+        hits += reference.hit;
+        filtered += got.out_of_reach > 0 ? 1 : 0;
+    }
+    // A meaningful sample: hits and misses, and the filter leaving features out.
+    EXPECT_GT(hits, trials / 5) << "seed " << seed;
+    EXPECT_LT(hits, trials * 4 / 5) << "seed " << seed;
+    EXPECT_GT(filtered, trials * 9 / 10) << "seed " << seed;
+}
+
 }  // namespace

@@ -5,7 +5,10 @@
 /// cut into time slices (a power of two, at most `max_time_slices`, so that a slice moves
 /// the fastest vertices about one mean edge length), processed in time order. In a slice, every
 /// feature (vertex, edge, triangle) has a box around its positions at the slice's two ends,
-/// which contains it throughout the slice by convexity (inflated to cover rounding); a
+/// which contains it throughout the slice by convexity (inflated to cover rounding). Only
+/// the features whose box over the whole step meets the other mesh's box over the whole
+/// step take part (no other can have a candidate pair): a small mesh against a large one
+/// builds hierarchies over the part of the large one it can reach. A
 /// hierarchy per feature kind, built once and refitted per slice, is descended together
 /// with the other mesh's to find the vertex-triangle and edge-edge pairs whose boxes
 /// overlap, and each is tested with the robust primitive over the slice only. The first
@@ -48,6 +51,8 @@ struct MeshContact {
     std::size_t primitive_queries = 0;  ///< vertex-face and edge-edge tests run
     std::size_t culled = 0;             ///< vertex-face tests skipped by `cull_back_facing`
     std::size_t time_slices = 0;        ///< slices examined (the step's, up to the contact)
+    /// Vertices, edges and triangles of both meshes left out: out of the other's reach.
+    std::size_t out_of_reach = 0;
 };
 
 /// Settings of the mesh-mesh test.
