@@ -280,8 +280,9 @@ void fillWall(WorldScene& scene, MeshBodies& bodies, Rng& rng, int count) {
         // half the body's bounding radius (12 cm and more here), let a body moving 18 cm per
         // step (44 m/s at 1/240 s) through the 2 cm wall with no time of impact asked. Half
         // the wall's thickness (1 cm) would exclude tunnelling by construction, but then every
-        // sliding or tumbling body computes times of impact against the ground and the wall
-        // (40 ms per frame at 1/60 s instead of 1.5).
+        // sliding or tumbling body computes times of impact against the ground and the wall,
+        // and one that turns about its contact is stopped there (a time of impact of 0) every
+        // step: 2.9 ms per frame at 1/60 s instead of 0.35, 4-5 of 8 bodies clamped per step.
         if (body->getCcdMotionThreshold() > 0) {
             body->setCcdMotionThreshold(btScalar(kWallCcdThreshold));
         }
