@@ -167,12 +167,7 @@ Options parse(int argc, char** argv) {
         } else if (flag == "--reference-substeps") {
             options.referenceSubsteps = int(kolize::demo::wholeNumber(flag, value, 2, 1000, fail));
         } else if (flag == "--fat-margin") {
-            char* end = nullptr;
-            options.fatMargin = std::strtod(value.c_str(), &end);
-            if (value.empty() || *end != '\0' || !(options.fatMargin >= 0) ||
-                !(options.fatMargin <= 10)) {
-                fail("--fat-margin needs a number in 0..10, got '" + value + "'");
-            }
+            options.fatMargin = kolize::demo::realNumber(flag, value, 0, 10, "a number", fail);
         } else if (flag == "--record") {
             options.record = value;
         } else if (flag == "--replay") {

@@ -13,6 +13,16 @@ namespace kolize::demo {
 
 using Fail = void (*)(const std::string& message);
 
+/// A bound for a message: "0", "1", "0.5", "10".
+inline std::string boundText(double x) {
+    std::string text = std::to_string(x);
+    text.erase(text.find_last_not_of('0') + 1);
+    if (!text.empty() && text.back() == '.') {
+        text.pop_back();
+    }
+    return text;
+}
+
 /// `text` as a whole number in low..high, else fail(...) naming `flag` (fail must not return).
 inline long wholeNumber(const std::string& flag, const std::string& text, long low, long high,
                         Fail fail) {
@@ -21,6 +31,19 @@ inline long wholeNumber(const std::string& flag, const std::string& text, long l
     if (text.empty() || *end != '\0' || value < low || value > high) {
         fail(flag + " needs a whole number in " + std::to_string(low) + ".." +
              std::to_string(high) + ", got '" + text + "'");
+    }
+    return value;
+}
+
+/// `text` as a number in [low, high] (`what` names it in the message, e.g. "metres"), else
+/// fail(...) naming `flag`.
+inline double realNumber(const std::string& flag, const std::string& text, double low, double high,
+                         const std::string& what, Fail fail) {
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !(value >= low) || !(value <= high)) {
+        fail(flag + " needs " + what + " in " + boundText(low) + ".." + boundText(high) +
+             ", got '" + text + "'");
     }
     return value;
 }

@@ -97,12 +97,7 @@ Options parse(int argc, char** argv) {
         } else if (flag == "--method") {
             options.methods = kolize::demo::chosen(flag, value, kMethods, fail);
         } else if (flag == "--contact-margin") {
-            char* end = nullptr;
-            options.contactMargin = std::strtod(value.c_str(), &end);
-            if (value.empty() || *end != '\0' || !(options.contactMargin >= 0) ||
-                !(options.contactMargin <= 1)) {
-                fail("--contact-margin needs metres in [0, 1], got '" + value + "'");
-            }
+            options.contactMargin = kolize::demo::realNumber(flag, value, 0, 1, "metres", fail);
         } else if (flag == "--frames") {
             options.frames = int(kolize::demo::wholeNumber(flag, value, 1, 1000000, fail));
         } else if (flag == "--n") {
