@@ -563,13 +563,18 @@ QuerySettings contactSettings() {
     return settings;
 }
 
-/// The pair's contact margin: the dispatcher's, at most the manifold's breaking threshold.
-double contactMargin(detail::PairStages& stages, const btPersistentManifold* manifold) {
-    const double margin = stages.planner().settings.contact_margin;
-    if (margin <= 0 || manifold == nullptr) {
-        return 0;
-    }
-    return std::min(margin, double(manifold->getContactBreakingThreshold()));
+/// The pair's contact margin: the dispatcher's, at most the manifold's breaking threshold;
+/// for Bullet's closest-point queries (contactTest and contactPairTest with the callback's
+/// m_closestDistanceThreshold, which hand their points to the callback, not to a manifold)
+/// at least that threshold.
+double contactMargin(detail::PairStages& stages, const btPersistentManifold* manifold,
+                     const btManifoldResult* result) {
+    double margin = stages.planner().settings.contact_margin;
+    margin = margin > 0 && manifold != nullptr
+                 ? std::min(margin, double(manifold->getContactBreakingThreshold()))
+                 : 0.0;
+    const double asked = result != nullptr ? double(result->m_closestPointDistanceThreshold) : 0.0;
+    return std::isfinite(asked) && asked > margin ? asked : margin;
 }
 
 /// After refreshContactPoints, for two meshes the exact test found apart: the kept points'
@@ -1028,7 +1033,7 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         const Pose poseA = toPose(body0->getWorldTransform());
         const Pose poseB = toPose(body1->getWorldTransform());
         QuerySettings base = contactSettings();
-        base.margin = contactMargin(state_->stages, manifold_);
+        base.margin = contactMargin(state_->stages, manifold_, resultOut);
         const QuerySettings settings = state_->stages.plan(
             base, shapeA->model().mesh().triangleCount(), shapeB->model().mesh().triangleCount());
         const QueryResult& result = state_->query.run(shapeA->model(), poseA, shapeB->model(),
@@ -1188,7 +1193,7 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             sceneryWrap->getWorldTransform().inverse() * meshWrap->getWorldTransform();
         btVector3 lo, hi;
         shape->getAabb(meshInScenery, lo, hi);
-        const double margin = contactMargin(state_->stages, manifold_);
+        const double margin = contactMargin(state_->stages, manifold_, resultOut);
         lo -= btVector3(1, 1, 1) * btScalar(margin);
         hi += btVector3(1, 1, 1) * btScalar(margin);
         SceneryCollector collector(toPose(sceneryWrap->getWorldTransform()));

@@ -596,6 +596,8 @@ TEST(BulletMeshStages, OneArgumentRegistrationRunsTheDefaultPlanner) {
     EXPECT_EQ(s.settings.sphere_window, 64);
     EXPECT_EQ(s.settings.sphere_rearm_after, 256);
     EXPECT_EQ(s.settings.tiny_pair_limit, MeshStageSettings().tiny_pair_limit);
+    EXPECT_EQ(s.settings.contact_margin, 0.0);
+    EXPECT_EQ(s.near_pairs, 0u);
     EXPECT_GT(s.mesh_mesh_queries, 0u);
     EXPECT_GT(s.no_tree_tiny, 0u);
     expectIdentities(s);

@@ -833,6 +833,48 @@ TEST(BulletMeshContacts, ContactMarginKeepsThePenetratingPointsOfIntersectingMes
     EXPECT_EQ(kolize::narrowphaseStages(&w.dispatcher).near_pairs, 0u);
 }
 
+// Bullet's closest-point queries: contactPairTest with the callback's
+// m_closestDistanceThreshold reports mesh pairs apart by up to it (points handed to the
+// callback, so the manifold's breaking threshold, 1.7 cm for this box, does not cut them),
+// also without a contact margin; without a threshold, nothing.
+TEST(BulletMeshContacts, ClosestPointQueriesReportMeshesWithinTheirThreshold) {
+    for (bool scenery : {false, true}) {
+        World w;
+        std::unique_ptr<Floor> floor;
+        btRigidBody* ground = nullptr;
+        if (scenery) {
+            floor = std::make_unique<Floor>(w);
+            ground = floor->floor;
+            for (btRigidBody* box : floor->boxes) {
+                box->getWorldTransform().setOrigin(btVector3(40, 0, 5));  // out of the way
+            }
+        } else {
+            ground = w.add(boxShape(Vec3(5, 5, 0.5)), at(0, 0, -0.5), 0);
+        }
+        const double gap = 0.03;
+        btRigidBody* box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(0.2, 0.1, 0.5 + gap, 0.3), 1);
+        for (double threshold : {0.0, 0.02, 0.05}) {
+            ContactCollector points;
+            points.m_closestDistanceThreshold = btScalar(threshold);
+            w.world.contactPairTest(box, ground, points);
+            const std::string where = std::string(scenery ? "scenery" : "mesh ground") +
+                                      " threshold " + std::to_string(threshold);
+            if (threshold < gap) {
+                EXPECT_TRUE(points.points.empty()) << where;
+                continue;
+            }
+            ASSERT_GE(points.points.size(), 3u) << where;
+            double closest = 1e9;
+            for (const btManifoldPoint& p : points.points) {
+                closest = std::min(closest, double(p.getDistance()));
+                EXPECT_NEAR(p.getDistance(), gap, 1e-5) << where;  // a flat box: every corner
+                EXPECT_NEAR(std::fabs(p.m_normalWorldOnB.z()), 1, 1e-6) << where;
+            }
+            EXPECT_NEAR(closest, gap, 1e-5) << where;
+        }
+    }
+}
+
 TEST(BulletMeshContacts, ContactMarginCatchesALandingBoxBeforeItSinksIn) {
     // A box mesh dropped 1 cm onto a box-mesh ground (0.45 m/s at landing, 7.5 mm per step):
     // without a margin the exact contacts respond once it is in (6.7 mm deep); with 1 cm of

@@ -61,6 +61,7 @@ TEST(MeshQuery, DefaultsAreTheDocumentedOnes) {
     EXPECT_EQ(q.descent, Descent::kBoth);
     EXPECT_FALSE(q.use_front);
     EXPECT_FALSE(q.facing_filter);
+    EXPECT_EQ(q.margin, 0.0);
     const TreeSettings t;
     EXPECT_EQ(t.kind, TreeKind::kObb);
     EXPECT_EQ(t.leaf_size, 4);

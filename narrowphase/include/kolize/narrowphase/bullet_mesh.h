@@ -22,7 +22,9 @@
 /// point each, halfway between their closest points, with a positive distance and the
 /// normal along them; never a penetration. Meshes that intersect get only the contacts of
 /// their intersecting pairs: a separated point within Bullet's breaking threshold of a
-/// penetrating one would replace it in the manifold, getCacheEntry). The intersecting pairs are
+/// penetrating one would replace it in the manifold, getCacheEntry). Bullet's closest-point
+/// queries (contactTest, contactPairTest) with the callback's m_closestDistanceThreshold get
+/// the same separated contacts up to that distance, with or without a contact margin. The intersecting pairs are
 /// grouped into patches (pairs whose triangles share a vertex index on either mesh). Per patch, the
 /// normal n and the depth come from a separating-axis test on the patch's own triangles: the
 /// candidate directions are their face normals (A's outward, B's reversed; outward is the winding's

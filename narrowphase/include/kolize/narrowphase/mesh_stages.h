@@ -94,7 +94,7 @@ struct MeshStageSettings {
 /// Counters of one dispatcher's mesh algorithms, added over all of its pairs, cumulative
 /// from registerNarrowphase or the last resetNarrowphaseStages. A query is one
 /// processCollision of a mesh-mesh pair (with finite transforms) or of a mesh-scenery pair
-/// that found scenery triangles in the mesh's box. Identities:
+/// that found scenery triangles in the mesh's box (widened by the contact margin). Identities:
 /// object_sphere_tests + sphere_skipped_auto + sphere_skipped_off = mesh queries (mesh_mesh +
 /// mesh_scenery), and mesh queries - object_sphere_rejects = tree_queries + no_tree_tiny +
 /// no_tree_off.
