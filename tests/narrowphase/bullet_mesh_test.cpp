@@ -735,6 +735,24 @@ std::vector<btManifoldPoint> manifoldPoints(World& w, btCollisionObject* a, btCo
     return out;
 }
 
+/// A ground with its top face at z = 0: the Floor scene's btBvhTriangleMeshShape (its two
+/// boxes moved out of the way) or a static box mesh offset by `shift` in x and y.
+struct FlatGround {
+    FlatGround(World& w, bool scenery, double shift) {
+        if (scenery) {
+            floor = std::make_unique<Floor>(w);
+            body = floor->floor;
+            for (btRigidBody* box : floor->boxes) {
+                box->getWorldTransform().setOrigin(btVector3(40, 0, 5));
+            }
+        } else {
+            body = w.add(boxShape(Vec3(5, 5, 0.5)), at(shift, 0.7 * shift, -0.5), 0);
+        }
+    }
+    std::unique_ptr<Floor> floor;
+    btRigidBody* body = nullptr;
+};
+
 // The contact margin: a box mesh hovering a known gap g above a box-mesh ground or a
 // btBvhTriangleMeshShape floor, turned and a little tilted, gets separated contacts whose
 // distances are the exact vertex heights (one of them the gap), never a penetration; none
@@ -746,17 +764,8 @@ TEST(BulletMeshContacts, ContactMarginMakesSeparatedContactsNeverPenetrations) {
             kolize::MeshStageSettings settings;
             settings.contact_margin = margin;
             kolize::registerNarrowphase(&w.dispatcher, settings);
-            std::unique_ptr<Floor> floor;
-            btRigidBody* ground = nullptr;
-            if (scenery) {
-                floor = std::make_unique<Floor>(w);
-                ground = floor->floor;
-                for (btRigidBody* box : floor->boxes) {
-                    box->getWorldTransform().setOrigin(btVector3(40, 0, 5));  // out of the way
-                }
-            } else {
-                ground = w.add(boxShape(Vec3(5, 5, 0.5)), at(0.3, 0.2, -0.5), 0);
-            }
+            const FlatGround flat(w, scenery, 0.3);
+            btRigidBody* ground = flat.body;
             btRigidBody* box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(0, 0, 5), 1);
             for (double gap : {0.002, 0.006, 0.02, 0.05}) {
                 btTransform t = at(0.1, -0.2, 0, 0.4);
@@ -840,17 +849,8 @@ TEST(BulletMeshContacts, ContactMarginKeepsThePenetratingPointsOfIntersectingMes
 TEST(BulletMeshContacts, ClosestPointQueriesReportMeshesWithinTheirThreshold) {
     for (bool scenery : {false, true}) {
         World w;
-        std::unique_ptr<Floor> floor;
-        btRigidBody* ground = nullptr;
-        if (scenery) {
-            floor = std::make_unique<Floor>(w);
-            ground = floor->floor;
-            for (btRigidBody* box : floor->boxes) {
-                box->getWorldTransform().setOrigin(btVector3(40, 0, 5));  // out of the way
-            }
-        } else {
-            ground = w.add(boxShape(Vec3(5, 5, 0.5)), at(0, 0, -0.5), 0);
-        }
+        const FlatGround flat(w, scenery, 0.0);
+        btRigidBody* ground = flat.body;
         const double gap = 0.03;
         btRigidBody* box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(0.2, 0.1, 0.5 + gap, 0.3), 1);
         for (double threshold : {0.0, 0.02, 0.05}) {
