@@ -40,8 +40,11 @@ struct Features {
     std::vector<int> vertices;
     std::vector<std::array<int, 2>> edges;  ///< smaller vertex index first
     std::vector<int> triangles;             ///< indices into MovingMesh::triangles
-    std::vector<int> touched;               ///< every vertex of a kept triangle (slice boxes)
-    std::size_t left_out = 0;               ///< vertices and triangles not kept
+    /// Each kept feature's box over the whole step (not inflated), in the lists' order;
+    /// moved into the hierarchies.
+    std::vector<Aabb> vertexBoxes, edgeBoxes, triangleBoxes;
+    std::vector<int> touched;  ///< every vertex of a kept triangle (slice boxes)
+    std::size_t left_out = 0;  ///< vertices and triangles not kept
 };
 
 Features collectFeatures(const MovingMesh& m, const Aabb& reach, double margin) {
@@ -63,7 +66,8 @@ Features collectFeatures(const MovingMesh& m, const Aabb& reach, double margin) 
     std::unordered_set<uint64_t> seen;
     for (size_t t = 0; t < m.triangles.size(); ++t) {
         const auto& tri = m.triangles[t];
-        if (!meets(sweptBox({tri[0], tri[1], tri[2]}))) {
+        const Aabb triangleBox = sweptBox({tri[0], tri[1], tri[2]});
+        if (!meets(triangleBox)) {
             ++f.left_out;
             for (int v : tri) {
                 used[v] = used[v] == 1 ? 1 : 2;  // used by some triangle, maybe not kept
@@ -71,21 +75,29 @@ Features collectFeatures(const MovingMesh& m, const Aabb& reach, double margin) 
             continue;  // nor can its edges and vertices (their boxes lie in its box)
         }
         f.triangles.push_back(static_cast<int>(t));
+        f.triangleBoxes.push_back(triangleBox);
         for (int i = 0; i < 3; ++i) {
             used[tri[i]] = 1;
             const int lo = std::min(tri[i], tri[(i + 1) % 3]);
             const int hi = std::max(tri[i], tri[(i + 1) % 3]);
-            if (lo != hi && meets(sweptBox({lo, hi})) &&
+            if (lo == hi) {
+                continue;
+            }
+            const Aabb edgeBox = sweptBox({lo, hi});
+            if (meets(edgeBox) &&
                 seen.insert(static_cast<uint64_t>(lo) << 32 | static_cast<uint32_t>(hi)).second) {
                 f.edges.push_back({lo, hi});
+                f.edgeBoxes.push_back(edgeBox);
             }
         }
     }
     for (size_t v = 0; v < used.size(); ++v) {
         if (used[v] == 1) {
             f.touched.push_back(static_cast<int>(v));
-            if (meets(sweptBox({static_cast<int>(v)}))) {
+            const Aabb vertexBox = sweptBox({static_cast<int>(v)});
+            if (meets(vertexBox)) {
                 f.vertices.push_back(static_cast<int>(v));
+                f.vertexBoxes.push_back(vertexBox);
                 continue;
             }
         }
@@ -99,8 +111,8 @@ Features collectFeatures(const MovingMesh& m, const Aabb& reach, double margin) 
 /// only the node boxes are recomputed per slice, bottom-up.
 class SliceBvh {
   public:
-    explicit SliceBvh(const std::vector<Aabb>& whole_step) : leaf_boxes_(whole_step) {
-        order_.resize(whole_step.size());
+    explicit SliceBvh(std::vector<Aabb> whole_step) : leaf_boxes_(std::move(whole_step)) {
+        order_.resize(leaf_boxes_.size());
         for (size_t i = 0; i < order_.size(); ++i) {
             order_[i] = static_cast<int>(i);
         }
@@ -243,18 +255,9 @@ class SlicedMesh {
         : mesh_(m),
           features_(collectFeatures(m, reach, margin)),
           margin_(margin),
-          vertices_(wholeStepBoxes(features_.vertices.size(),
-                                   [&](size_t i, Aabb& b) { sweep(features_.vertices[i], b); })),
-          edges_(wholeStepBoxes(features_.edges.size(),
-                                [&](size_t i, Aabb& b) {
-                                    sweep(features_.edges[i][0], b);
-                                    sweep(features_.edges[i][1], b);
-                                })),
-          triangles_(wholeStepBoxes(features_.triangles.size(), [&](size_t i, Aabb& b) {
-              for (int v : m.triangles[features_.triangles[i]]) {
-                  sweep(v, b);
-              }
-          })) {
+          vertices_(std::move(features_.vertexBoxes)),  // the features keep their lists only
+          edges_(std::move(features_.edgeBoxes)),
+          triangles_(std::move(features_.triangleBoxes)) {
         at0_.resize(m.start.size());
         at1_.resize(m.start.size());
     }
@@ -304,18 +307,6 @@ class SlicedMesh {
     const SliceBvh& triangles() const { return triangles_; }
 
   private:
-    template <class Fill>
-    static std::vector<Aabb> wholeStepBoxes(size_t count, Fill fill) {
-        std::vector<Aabb> boxes(count);
-        for (size_t i = 0; i < count; ++i) {
-            fill(i, boxes[i]);
-        }
-        return boxes;
-    }
-    void sweep(int v, Aabb& b) const {
-        b.grow(mesh_.start[v]);
-        b.grow(mesh_.end[v]);
-    }
     void slice(int v, Aabb& b) const {
         b.grow(at0_[v]);
         b.grow(at1_[v]);
@@ -369,25 +360,28 @@ MeshContact meshCcd(const MovingMesh& a, const MovingMesh& b, const MeshCcdSetti
     // Slice boxes come from positions x0 + t (x1 - x0) rounded to doubles: inflating every
     // box by a few units in the last place of the largest coordinate keeps it around the
     // exact positions, so the culling never drops a pair that touches.
+    // Each mesh's box over the whole step (inflated below): the other's reach.
+    Aabb reach[2];
+    for (int k = 0; k < 2; ++k) {
+        const MovingMesh& m = k == 0 ? a : b;
+        for (size_t v = 0; v < m.start.size(); ++v) {
+            reach[k].grow(m.start[v]);
+            reach[k].grow(m.end[v]);
+        }
+    }
     double largest = 0.0;
-    for (const MovingMesh* m : {&a, &b}) {
-        for (size_t v = 0; v < m->start.size(); ++v) {
-            largest = std::max(
-                {largest, m->start[v].cwiseAbs().maxCoeff(), m->end[v].cwiseAbs().maxCoeff()});
+    for (const Aabb& box : reach) {
+        if (box.lo.x() <= box.hi.x()) {  // not empty
+            largest =
+                std::max({largest, box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff()});
         }
     }
     const double margin = 8.0 * 0x1p-53 * largest + std::numeric_limits<double>::min();
-    auto reach = [margin](const MovingMesh& m) {  // the whole step's box, inflated
-        Aabb box;
-        for (size_t v = 0; v < m.start.size(); ++v) {
-            box.grow(m.start[v]);
-            box.grow(m.end[v]);
-        }
+    for (Aabb& box : reach) {
         box.lo.array() -= margin;
         box.hi.array() += margin;
-        return box;
-    };
-    SlicedMesh sa(a, margin, reach(b)), sb(b, margin, reach(a));
+    }
+    SlicedMesh sa(a, margin, reach[1]), sb(b, margin, reach[0]);
     MeshContact best;
     best.out_of_reach = sa.features().left_out + sb.features().left_out;
     const int slices = sliceCount(a, b, settings.max_time_slices);
