@@ -2,6 +2,8 @@
 
 #include "kolize/narrowphase/mesh_ccd.h"
 
+#include "convex_ccd.h"
+#include <BulletCollision/CollisionShapes/btConvexShape.h>
 #include "mesh_stages_internal.h"
 
 #include <BulletCollision/CollisionDispatch/btCollisionConfiguration.h>
@@ -808,14 +810,19 @@ struct MeshStep {
     Pose start, end;
 };
 
+/// The two steps and their moving meshes (buffers reused from call to call).
+struct CcdBuffers {
+    MeshStep stepA, stepB;
+    ccd::MovingMesh movingA, movingB;  ///< the meshCcd input
+};
+
 struct MeshContactAlgorithm::State {
     explicit State(std::shared_ptr<detail::StagePlanner> planner) : stages(std::move(planner)) {}
     detail::PairStages stages;  ///< the stage planner's decisions for this pair
     narrowphase::MeshQuery query;
     std::vector<MeshContact> contacts;
-    MeshStep stepA, stepB;              ///< filled by calculateTimeOfImpact
+    CcdBuffers ccd;                     ///< filled by calculateTimeOfImpact
     std::vector<Vec3> sceneryVertices;  ///< scenery triangles' vertices (world)
-    ccd::MovingMesh movingA, movingB;   ///< the meshCcd input (buffers reused)
 };
 
 namespace {
@@ -914,18 +921,18 @@ double ccdThresholdOfPair(const btCollisionObject& a, const btCollisionObject& b
     return threshold;
 }
 
-/// Whether some vertex of `a` moves towards `b` along the normal of one of `contacts` (from
+/// Whether some vertex of `a` moves towards `b` along one of the contact `normals` (from
 /// a towards b), relative to b, by more than `limit` over the step.
-bool drivesIn(const std::vector<MeshContact>& contacts, const ccd::MovingMesh& a,
-              const ccd::MovingMesh& b, double limit) {
-    for (const MeshContact& contact : contacts) {
+bool drivesIn(const std::vector<Vec3>& normals, const ccd::MovingMesh& a, const ccd::MovingMesh& b,
+              double limit) {
+    for (const Vec3& normal : normals) {
         double forwardA = -std::numeric_limits<double>::infinity();
         for (std::size_t i = 0; i < a.start.size(); ++i) {
-            forwardA = std::max(forwardA, (a.end[i] - a.start[i]).dot(contact.normal));
+            forwardA = std::max(forwardA, (a.end[i] - a.start[i]).dot(normal));
         }
         double forwardB = std::numeric_limits<double>::infinity();
         for (std::size_t i = 0; i < b.start.size(); ++i) {
-            forwardB = std::min(forwardB, (b.end[i] - b.start[i]).dot(contact.normal));
+            forwardB = std::min(forwardB, (b.end[i] - b.start[i]).dot(normal));
         }
         if (forwardA - forwardB > limit) {
             return true;
@@ -947,17 +954,23 @@ bool exceedsCcdMotionThreshold(const btCollisionObject& object) {
     return threshold > 0 && threshold < motion;
 }
 
-btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
-                                                  btCollisionObject* body1) {
-    State& s = *state_;
+namespace {
+
+/// The time of impact of the steps in `s` for the bodies `body0` (A) and `body1` (B), as
+/// MeshContactAlgorithm's comment says; `normals` are the normals (from A towards B) of the
+/// pair's contacts at the start of the step, empty when it did not touch. `hit` tells
+/// whether meshCcd found a contact.
+btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals,
+                               btCollisionObject* body0, btCollisionObject* body1, bool& hit) {
+    hit = false;
     if (!place(s.stepA, 0, 1, s.movingA) || !place(s.stepB, 0, 1, s.movingB)) {
         return btScalar(1);
     }
     // In contact at the start: the contacts hold the pair unless a vertex drives in along
     // their normals by more than a CCD threshold (a body turning about its contact sweeps
     // the rest of itself into, and through, the other; sliding or leaving does not).
-    if (!s.contacts.empty() &&
-        !drivesIn(s.contacts, s.movingA, s.movingB, ccdThresholdOfPair(*body0, *body1))) {
+    if (!normals.empty() &&
+        !drivesIn(normals, s.movingA, s.movingB, ccdThresholdOfPair(*body0, *body1))) {
         return btScalar(1);
     }
     const double turn = std::max(turnOf(s.stepA), turnOf(s.stepB));
@@ -968,14 +981,14 @@ btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
             (!place(s.stepA, f0, f1, s.movingA) || !place(s.stepB, f0, f1, s.movingB))) {
             return btScalar(1);
         }
-        const ccd::MeshContact hit = ccd::meshCcd(s.movingA, s.movingB);
-        if (!hit.hit) {
+        const ccd::MeshContact contact = ccd::meshCcd(s.movingA, s.movingB);
+        if (!contact.hit) {
             continue;
         }
         // Rounded down: the fraction handed to Bullet stays no later than the contact.
         const btScalar toi =
-            std::clamp(roundOutward(f0 + hit.toi * (f1 - f0), false), btScalar(0), btScalar(1));
-        s.stages.countTimeOfImpactHit();
+            std::clamp(roundOutward(f0 + contact.toi * (f1 - f0), false), btScalar(0), btScalar(1));
+        hit = true;
         for (btCollisionObject* body : {body0, body1}) {
             if (movesOverStep(*body) && body->getHitFraction() > toi) {
                 body->setHitFraction(toi);
@@ -984,6 +997,23 @@ btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
         return toi;
     }
     return btScalar(1);
+}
+
+}  // namespace
+
+btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
+                                                  btCollisionObject* body1) {
+    State& s = *state_;
+    std::vector<Vec3> normals;
+    for (const MeshContact& contact : s.contacts) {
+        normals.push_back(contact.normal);
+    }
+    bool hit = false;
+    const btScalar toi = piecewiseTimeOfImpact(s.ccd, normals, body0, body1, hit);
+    if (hit) {
+        s.stages.countTimeOfImpactHit();
+    }
+    return toi;
 }
 
 MeshContactAlgorithm::MeshContactAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -1069,12 +1099,12 @@ btScalar MeshMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
         static_cast<const MeshShape*>(body0->getCollisionShape())->model().mesh();
     const TriangleMesh& meshB =
         static_cast<const MeshShape*>(body1->getCollisionShape())->model().mesh();
-    if (!stepOf(*body0, meshA.vertices(), state_->stepA) ||
-        !stepOf(*body1, meshB.vertices(), state_->stepB)) {
+    if (!stepOf(*body0, meshA.vertices(), state_->ccd.stepA) ||
+        !stepOf(*body1, meshB.vertices(), state_->ccd.stepB)) {
         return btScalar(1);
     }
-    setTriangles(meshA.triangles(), state_->movingA);
-    setTriangles(meshB.triangles(), state_->movingB);
+    setTriangles(meshA.triangles(), state_->ccd.movingA);
+    setTriangles(meshB.triangles(), state_->ccd.movingB);
     return reportTimeOfImpact(body0, body1);
 }
 
@@ -1095,6 +1125,13 @@ ConvexMeshAlgorithm::ConvexMeshAlgorithm(const btCollisionAlgorithmConstructionI
       triangles_(ci.m_dispatcher1, body0, body1, meshFirst),
       meshFirst_(meshFirst) {}
 
+struct ConvexMeshAlgorithm::Ccd {
+    const btCollisionShape* shape = nullptr;  ///< whose surface `polytope` is
+    detail::EnclosingPolytope polytope;
+    CcdBuffers buffers;
+    std::vector<Vec3> normals;
+};
+
 ConvexMeshAlgorithm::~ConvexMeshAlgorithm() = default;
 
 void ConvexMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
@@ -1113,9 +1150,69 @@ void ConvexMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0
     triangles_.clearWrapperData();
 }
 
-btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject*, btCollisionObject*,
+btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
+                                                    btCollisionObject* body1,
                                                     const btDispatcherInfo&, btManifoldResult*) {
-    return btScalar(1);
+    if (!exceedsCcdMotionThreshold(*body0) && !exceedsCcdMotionThreshold(*body1)) {
+        return btScalar(1);
+    }
+    btCollisionObject* meshObject = meshFirst_ ? body0 : body1;
+    btCollisionObject* convexObject = meshFirst_ ? body1 : body0;
+    const btCollisionShape* convexShape = convexObject->getCollisionShape();
+    if (!convexShape || !convexShape->isConvex()) {
+        return btScalar(1);
+    }
+    const auto& convex = *static_cast<const btConvexShape*>(convexShape);
+    if (!ccd_) {
+        ccd_ = std::make_unique<Ccd>();
+    }
+    Ccd& c = *ccd_;
+    if (c.shape != convexShape || !detail::encloses(c.polytope, convex)) {
+        c.shape = nullptr;
+        if (!detail::enclosingPolytope(convex, c.polytope)) {
+            return btScalar(1);
+        }
+        c.shape = convexShape;
+    }
+    const TriangleMesh& mesh =
+        static_cast<const MeshShape*>(meshObject->getCollisionShape())->model().mesh();
+    if (!stepOf(*meshObject, mesh.vertices(), c.buffers.stepA) ||
+        !stepOf(*convexObject, c.polytope.vertices, c.buffers.stepB)) {
+        return btScalar(1);
+    }
+    setTriangles(mesh.triangles(), c.buffers.movingA);
+    setTriangles(c.polytope.triangles, c.buffers.movingB);
+    // The manifold's bodies are (convex, mesh): its normals on B point from the mesh (A
+    // here) towards the convex (B here).
+    c.normals.clear();
+    if (const btPersistentManifold* manifold = triangles_.m_manifoldPtr) {
+        for (int i = 0; i < manifold->getNumContacts(); ++i) {
+            c.normals.push_back(toVec3(manifold->getContactPoint(i).m_normalWorldOnB));
+        }
+    }
+    const btScalar fractionMesh = meshObject->getHitFraction();
+    const btScalar fractionConvex = convexObject->getHitFraction();
+    bool hit = false;
+    btScalar toi = piecewiseTimeOfImpact(c.buffers, c.normals, meshObject, convexObject, hit);
+    if (!hit || !(c.polytope.standoff > 0)) {
+        return toi;
+    }
+    // The surface stands off a round shape: from its time on, advance to the shape itself.
+    const auto* meshShape = static_cast<const btConcaveShape*>(meshObject->getCollisionShape());
+    const double tolerance = 1e-3 * double(convex.getAngularMotionDisc());
+    const double advanced = detail::advanceToContact(
+        convex, {&convexObject->getWorldTransform(), &endOfStep(*convexObject)}, *meshShape,
+        {&meshObject->getWorldTransform(), &endOfStep(*meshObject)}, double(toi), tolerance);
+    toi = std::clamp(roundOutward(advanced, false), toi, btScalar(1));
+    meshObject->setHitFraction(std::min(fractionMesh, toi));
+    convexObject->setHitFraction(std::min(fractionConvex, toi));
+    if (!movesOverStep(*meshObject)) {
+        meshObject->setHitFraction(fractionMesh);
+    }
+    if (!movesOverStep(*convexObject)) {
+        convexObject->setHitFraction(fractionConvex);
+    }
+    return toi;
 }
 
 void ConvexMeshAlgorithm::getAllContactManifolds(btManifoldArray& manifolds) {
@@ -1262,16 +1359,16 @@ btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCol
         return btScalar(1);
     }
     const TriangleMesh& mesh = shape->model().mesh();
-    if (!stepOf(*meshObject, mesh.vertices(), state_->stepA)) {
+    if (!stepOf(*meshObject, mesh.vertices(), state_->ccd.stepA)) {
         return btScalar(1);
     }
-    setTriangles(mesh.triangles(), state_->movingA);
+    setTriangles(mesh.triangles(), state_->ccd.movingA);
     // The scenery's triangles are already in the world, where they stay.
     state_->sceneryVertices = std::move(collector.vertices);
-    state_->stepB.vertices = &state_->sceneryVertices;
-    state_->stepB.start = Pose();
-    state_->stepB.end = Pose();
-    setTriangles(collector.triangles, state_->movingB);
+    state_->ccd.stepB.vertices = &state_->sceneryVertices;
+    state_->ccd.stepB.start = Pose();
+    state_->ccd.stepB.end = Pose();
+    setTriangles(collector.triangles, state_->ccd.movingB);
     return reportTimeOfImpact(body0, body1);
 }
 

@@ -97,10 +97,11 @@ void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
             m_dispatcher1->findAlgorithm(&wrapA, &wrapB, nullptr, BT_CONTACT_POINT_ALGORITHMS);
         temporary = algorithm != nullptr;
     }
-    if (auto* mesh = dynamic_cast<MeshContactAlgorithm*>(algorithm)) {
+    if (dynamic_cast<MeshContactAlgorithm*>(algorithm) ||
+        dynamic_cast<ConvexMeshAlgorithm*>(algorithm)) {
         ++counters_.pairs;
         // Both bodies go `penetration` past the time of impact, to make their contact.
-        const btScalar toi = mesh->calculateTimeOfImpact(a, b, getDispatchInfo(), nullptr);
+        const btScalar toi = algorithm->calculateTimeOfImpact(a, b, getDispatchInfo(), nullptr);
         if (toi < 1) {
             for (btCollisionObject* object : {a, b}) {
                 const double length = motionLength(*object);
@@ -179,12 +180,42 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
             }
             btTransform clamped;
             body->predictIntegratedTransform(timeStep * btScalar(fraction), clamped);
-            clamped_.push_back({body, clamped, hit});
+            clamped_.push_back({body, clamped, hit, fraction, body->getWorldTransform().getOrigin(),
+                                body->getInterpolationWorldTransform().getOrigin()});
         }
     }
+    // Convex bodies first: Bullet's swept sphere of a convex body tests the others where
+    // they are when it runs, and a mesh body integrated before it would already stand at
+    // the end of its step (a box pushing a ball at 50 m/s would be in front of it, and
+    // Bullet would stop the ball against the box's back). Mesh bodies' motions are this
+    // pass's business (the pairs above, which see both motions). Same order otherwise.
+    integrationOrder_.clear();
+    for (int convex = 1; convex >= 0; --convex) {
+        for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
+            btRigidBody* body = m_nonStaticRigidBodies[i];
+            const bool isConvex =
+                body->getCollisionShape() && body->getCollisionShape()->isConvex();
+            if (isConvex == bool(convex)) {
+                integrationOrder_.push_back(body);
+            }
+        }
+    }
+    worldOrder_.copyFromArray(m_nonStaticRigidBodies);
+    m_nonStaticRigidBodies.copyFromArray(integrationOrder_);
     btDiscreteDynamicsWorld::integrateTransforms(timeStep);
-    // Bullet's integrator reset every hit fraction and moved these bodies the whole step.
+    m_nonStaticRigidBodies.copyFromArray(worldOrder_);
+    // Bullet's integrator reset every hit fraction and moved these bodies the whole step, or,
+    // for a convex body its swept sphere stopped (hit fraction 0 after it), part of it:
+    // that body keeps the shorter of the two motions.
     for (const Clamp& clamp : clamped_) {
+        if (clamp.body->getHitFraction() == 0) {
+            const btScalar whole = (clamp.end - clamp.start).length();
+            const btScalar bullet =
+                (clamp.body->getWorldTransform().getOrigin() - clamp.start).length();
+            if (!(whole > 0) || double(bullet / whole) <= clamp.fraction) {
+                continue;
+            }
+        }
         clamp.body->proceedToTransform(clamp.transform);
         clamp.body->setHitFraction(clamp.hitFraction);
         ++counters_.clamped;

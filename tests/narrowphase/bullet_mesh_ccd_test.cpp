@@ -374,6 +374,159 @@ TEST(BulletMeshTimeOfImpact, MeshAgainstTriangleMeshScenery) {
     }
 }
 
+/// The half extents as Bullet's float shapes hold them (the analytic times use these).
+double asShape(double x) {
+    return double(btScalar(x));
+}
+
+TEST(ConvexMeshTimeOfImpact, TranslatingBoxesMatchTheAnalyticTimeEitherBodyConvex) {
+    // The 20 cm box against the 1 cm wall as in TranslatingBoxMatchesTheAnalyticTime, with
+    // one of the two a Bullet btBoxShape (its default margin lies inside its half extents)
+    // and the other a MeshShape, in both algorithm orders, the mover either one.
+    auto convexWall = std::make_shared<btBoxShape>(
+        btVector3(btScalar(kWallHalf.x()), btScalar(kWallHalf.y()), btScalar(kWallHalf.z())));
+    auto convexBox = std::make_shared<btBoxShape>(
+        btVector3(btScalar(kBoxHalf.x()), btScalar(kBoxHalf.y()), btScalar(kBoxHalf.z())));
+    std::mt19937 random(20261203);
+    std::uniform_real_distribution<double> startX(-1.5, -0.2), endX(-1.0, 1.5), side(-1.0, 1.0),
+        drift(-0.2, 0.2);
+    const int cases = kolize::narrowphase::testing::scaled(100);
+    for (bool convexMoves : {true, false}) {
+        for (bool moverFirst : {true, false}) {
+            std::shared_ptr<btCollisionShape> mover =
+                convexMoves ? std::shared_ptr<btCollisionShape>(convexBox) : meshBox(kBoxHalf);
+            std::shared_ptr<btCollisionShape> wall =
+                convexMoves ? std::shared_ptr<btCollisionShape>(meshBox(kWallHalf)) : convexWall;
+            Pair pair = moverFirst ? Pair(mover, 1, wall, 0) : Pair(wall, 0, mover, 1);
+            ASSERT_NE(dynamic_cast<kolize::ConvexMeshAlgorithm*>(pair.algorithm), nullptr);
+            btRigidBody& body = moverFirst ? *pair.a : *pair.b;
+            btRigidBody& still = moverFirst ? *pair.b : *pair.a;
+            int hits = 0;
+            for (int i = 0; i < cases; ++i) {
+                const double y = side(random), z = side(random);
+                const btTransform start = at(startX(random), y, z);
+                btTransform end = at(endX(random), y + drift(random), z + drift(random));
+                if (end.getOrigin().x() <= start.getOrigin().x()) {
+                    end.getOrigin().setX(start.getOrigin().x() + btScalar(0.05));
+                }
+                Pair::move(body, start, end);
+                Pair::move(still, at(0, 0, 0), at(0, 0, 0));
+                const btScalar toi = pair.timeOfImpact();
+                const double x0 = double(start.getOrigin().x()), x1 = double(end.getOrigin().x());
+                const double face = asShape(kWallHalf.x()) + asShape(kBoxHalf.x());
+                const bool reaches = x1 + face >= 0;
+                const double analytic = (-face - x0) / (x1 - x0);
+                SCOPED_TRACE(std::string(convexMoves ? "convex" : "mesh") + " moves, " +
+                             (moverFirst ? "first" : "second") + ", case " + std::to_string(i) +
+                             " x0 " + std::to_string(x0) + " x1 " + std::to_string(x1));
+                ASSERT_EQ(toi < 1, reaches);
+                if (reaches) {
+                    ++hits;
+                    EXPECT_LE(double(toi), analytic + 1e-12);  // never late
+                    EXPECT_GE(double(toi), analytic - 1e-5);
+                    EXPECT_EQ(body.getHitFraction(), toi);
+                }
+            }
+            EXPECT_GT(hits, cases * 3 / 10);
+            EXPECT_LT(hits, cases * 7 / 10);
+        }
+    }
+}
+
+TEST(ConvexMeshTimeOfImpact, RoundShapesAreHitNeverLateAndAtMostAMillimetreEarly) {
+    // The mesh box flies face first at a sphere, a capsule and a cylinder (axis along y):
+    // the first contact is the face reaching x = -r, the shape's nearest point. The time
+    // against the surface around the shape is advanced to the shape (to within 1e-3 of its
+    // angular motion disc, 0.3 mm to 1 mm here).
+    const double r = asShape(0.3);
+    const std::vector<std::pair<std::string, std::shared_ptr<btCollisionShape>>> targets = {
+        {"sphere", std::make_shared<btSphereShape>(btScalar(0.3))},
+        {"capsule", std::make_shared<btCapsuleShape>(btScalar(0.3), btScalar(1))},
+        {"cylinder", std::make_shared<btCylinderShape>(btVector3(btScalar(0.3), 1, btScalar(0.3)))},
+    };
+    std::mt19937 random(20261204);
+    std::uniform_real_distribution<double> startX(-2.0, -0.5), endX(-1.6, 0.6), side(-0.09, 0.09);
+    for (const auto& [name, target] : targets) {
+        Pair pair(meshBox(kBoxHalf), 1, target, 0);
+        int hits = 0;
+        const int cases = kolize::narrowphase::testing::scaled(100);
+        for (int i = 0; i < cases; ++i) {
+            // Within 9 cm of the axis: the nearest point (-r, 0, 0) is on the box's face.
+            const double y = side(random), z = side(random);
+            const btTransform start = at(startX(random), y, z);
+            btTransform end = at(endX(random), y, z);
+            if (end.getOrigin().x() <= start.getOrigin().x() + 0.05) {
+                end.getOrigin().setX(start.getOrigin().x() + btScalar(0.05));
+            }
+            Pair::move(*pair.a, start, end);
+            Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));
+            const btScalar toi = pair.timeOfImpact();
+            const double x0 = double(start.getOrigin().x()), x1 = double(end.getOrigin().x());
+            const double reach = r + kBoxHalf.x();
+            const double analytic = (-reach - x0) / (x1 - x0);
+            const double early = 1e-3 / (x1 - x0);  // a millimetre
+            SCOPED_TRACE(name + ", case " + std::to_string(i) + " x0 " + std::to_string(x0) +
+                         " x1 " + std::to_string(x1));
+            if (x1 + reach >= 0) {
+                ++hits;
+                ASSERT_LT(toi, btScalar(1));
+                EXPECT_LE(double(toi), analytic + 1e-12);
+                EXPECT_GE(double(toi), analytic - early);
+            } else {
+                EXPECT_EQ(toi, btScalar(1));  // stops short
+            }
+        }
+        EXPECT_GT(hits, cases / 4);
+        EXPECT_LT(hits, cases * 3 / 4);
+        // Passing 1 cm over it (its top at y = r): inside the surface around it (which
+        // stands off a 30 cm round shape by up to 1.8 cm), but no contact with the shape.
+        Pair::move(*pair.a, at(-1, r + kBoxHalf.y() + 0.01, 0), at(1, r + kBoxHalf.y() + 0.01, 0));
+        Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));
+        if (name != "capsule" && name != "cylinder") {
+            EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+        }
+        // And 1 cm in front of it, along its axis (y) for the capsule and the cylinder.
+        Pair::move(*pair.a, at(-1, 0, r + kBoxHalf.z() + 0.01), at(1, 0, r + kBoxHalf.z() + 0.01));
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1)) << name << " passed 1 cm beside";
+    }
+}
+
+TEST(ConvexMeshTimeOfImpact, PairsInContactAreLeftToTheContactsUnlessDrivenIn) {
+    // PairsInContactAtTheStartAreLeftToTheContactsUnlessDrivenIn with a btBoxShape wall: the
+    // manifold's normals (Bullet's, on the mesh) must point the way the mesh drives in.
+    for (bool meshFirst : {true, false}) {
+        SCOPED_TRACE(meshFirst ? "mesh first" : "convex first");
+        auto wall = std::make_shared<btBoxShape>(
+            btVector3(btScalar(kWallHalf.x()), btScalar(kWallHalf.y()), btScalar(kWallHalf.z())));
+        Pair pair =
+            meshFirst ? Pair(meshBox(kBoxHalf), 1, wall, 0) : Pair(wall, 0, meshBox(kBoxHalf), 1);
+        btRigidBody& box = meshFirst ? *pair.a : *pair.b;
+        btRigidBody& still = meshFirst ? *pair.b : *pair.a;
+        const btTransform start = at(-0.1, 0, 0);
+        Pair::move(still, at(0, 0, 0), at(0, 0, 0));
+        Pair::move(box, start, start);
+        const btCollisionObjectWrapper wrapA(nullptr, pair.shapeA_.get(), pair.a.get(),
+                                             pair.a->getWorldTransform(), -1, -1);
+        const btCollisionObjectWrapper wrapB(nullptr, pair.shapeB_.get(), pair.b.get(),
+                                             pair.b->getWorldTransform(), -1, -1);
+        const btTransform slide = at(-0.1, 0.5, 0.3), driveIn = at(0.5, 0, 0);
+        Pair::move(box, start, slide);
+        EXPECT_LT(pair.timeOfImpact(), btScalar(1));  // no contacts yet
+        btManifoldResult result(&wrapA, &wrapB);
+        pair.algorithm->processCollision(&wrapA, &wrapB, pair.dispatchInfo, &result);
+        btManifoldArray manifolds;
+        pair.algorithm->getAllContactManifolds(manifolds);
+        ASSERT_EQ(manifolds.size(), 1);
+        ASSERT_GT(manifolds[0]->getNumContacts(), 0);
+        Pair::move(box, start, slide);
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+        Pair::move(box, start, driveIn);
+        EXPECT_LT(pair.timeOfImpact(), btScalar(1));
+        Pair::move(box, start, at(-0.7, 0, 0));  // leaving fast
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // The wall in a world
 
@@ -401,7 +554,7 @@ const char* name(Method m) {
     return "";
 }
 
-enum class WallKind { kStaticMesh, kKinematicMesh, kScenery };
+enum class WallKind { kStaticMesh, kKinematicMesh, kScenery, kConvexBox };
 
 struct ThrowResult {
     int bodies = 0;
@@ -446,6 +599,9 @@ ThrowResult throwAtWall(Method method, WallKind wallKind, double speed, int step
             sceneryTriangles.addTriangle(v(0), v(1), v(2));
         }
         wallShape = std::make_unique<btBvhTriangleMeshShape>(&sceneryTriangles, true);
+    } else if (wallKind == WallKind::kConvexBox) {
+        wallShape = std::make_unique<btBoxShape>(
+            btVector3(btScalar(kWallHalf.x()), btScalar(kWallHalf.y()), btScalar(kWallHalf.z())));
     } else {
         wallShape = std::make_unique<MeshShape>(kolize::makeMeshModel(wallMesh));
     }
@@ -539,11 +695,13 @@ TEST(BulletMeshCcdWorld, ThinWallStopsEveryBodyAtEverySpeed) {
     const Method methods[] = {Method::kMeshCcdWorld, Method::kMeshCcdWorldOff,
                               Method::kBulletCcdMeshBody, Method::kBulletCcdConvexBody,
                               Method::kBulletCcdConvexBodySmallSphere};
-    const char* wallNames[] = {"static", "kinematic", "scenery"};
+    const char* wallNames[] = {"static", "kinematic", "scenery", "btBoxShape"};
     for (Method method : methods) {
-        for (WallKind wall :
-             {WallKind::kStaticMesh, WallKind::kKinematicMesh, WallKind::kScenery}) {
-            if (method != Method::kMeshCcdWorld && wall != WallKind::kStaticMesh) {
+        for (WallKind wall : {WallKind::kStaticMesh, WallKind::kKinematicMesh, WallKind::kScenery,
+                              WallKind::kConvexBox}) {
+            const bool shown = wall == WallKind::kStaticMesh ||
+                               (wall == WallKind::kConvexBox && method == Method::kMeshCcdWorldOff);
+            if (method != Method::kMeshCcdWorld && !shown) {
                 continue;
             }
             std::printf("%-44s %-10s", name(method), wallNames[int(wall)]);
@@ -621,6 +779,74 @@ TEST(BulletMeshCcdWorld, TwoFastMeshBodiesStopEachOther) {
     EXPECT_GE(clamped, 2u);  // both stopped at the same time of impact
     for (auto& body : bodies) {
         world.removeRigidBody(body.get());
+    }
+}
+
+/// A 20 cm mesh box thrown at 100 m/s along +x at a dynamic convex body (a 1 cm plate or a
+/// 10 cm ball, centred on its path) flying at it at `otherSpeed` with Bullet's own CCD (its
+/// swept sphere); 30 steps of 1/60 s, zero gravity. Whether the box ever ended a step past
+/// the other body's centre.
+bool passesThroughConvexBody(bool meshCcd, bool ball, double otherSpeed) {
+    btDefaultCollisionConfiguration configuration;
+    btCollisionDispatcher dispatcher(&configuration);
+    kolize::registerNarrowphase(&dispatcher);
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    MeshCcdWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    world.setGravity(btVector3(0, 0, 0));
+    std::unique_ptr<btCollisionShape> otherShape;
+    if (ball) {
+        otherShape = std::make_unique<btSphereShape>(btScalar(0.05));
+    } else {
+        otherShape = std::make_unique<btBoxShape>(btVector3(btScalar(0.005), 1, 1));
+        otherShape->setMargin(btScalar(0.001));  // Bullet's 4 cm default is thicker than it
+    }
+    auto boxShape = meshBox(kBoxHalf);
+    std::vector<std::unique_ptr<btRigidBody>> bodies;
+    for (int k = 0; k < 2; ++k) {
+        btCollisionShape* shape =
+            k == 0 ? static_cast<btCollisionShape*>(boxShape.get()) : otherShape.get();
+        btVector3 inertia;
+        shape->calculateLocalInertia(1, inertia);
+        btRigidBody::btRigidBodyConstructionInfo info(1, nullptr, shape, inertia);
+        info.m_startWorldTransform = at(k == 0 ? -1.03 : 1.0, 0, 0);
+        auto body = std::make_unique<btRigidBody>(info);
+        body->setActivationState(DISABLE_DEACTIVATION);
+        body->setLinearVelocity(btVector3(btScalar(k == 0 ? 100 : -otherSpeed), 0, 0));
+        if (k == 0 && meshCcd) {
+            body->setCcdMotionThreshold(btScalar(kThreshold));
+        }
+        if (k == 1) {
+            body->setCcdMotionThreshold(btScalar(kThreshold));
+            body->setCcdSweptSphereRadius(btScalar(0.004));
+        }
+        world.addRigidBody(body.get());
+        bodies.push_back(std::move(body));
+    }
+    bool passed = false;
+    for (int step = 0; step < 30; ++step) {
+        world.stepSimulation(btScalar(1.0 / 60), 0);
+        passed = passed || bodies[0]->getWorldTransform().getOrigin().x() >
+                               bodies[1]->getWorldTransform().getOrigin().x();
+    }
+    for (auto& body : bodies) {
+        world.removeRigidBody(body.get());
+    }
+    return passed;
+}
+
+TEST(BulletMeshCcdWorld, MeshBodiesStopAtDynamicConvexBodies) {
+    for (bool ball : {false, true}) {
+        for (double otherSpeed : {0.0, 100.0}) {
+            SCOPED_TRACE(std::string(ball ? "10 cm ball" : "1 cm plate") + " at " +
+                         std::to_string(otherSpeed) + " m/s");
+            EXPECT_FALSE(passesThroughConvexBody(true, ball, otherSpeed));
+            // Without the mesh body's CCD it goes through (the other's swept sphere, 4 mm,
+            // stops it only against what it meets itself, when it moves).
+            if (otherSpeed == 0) {
+                EXPECT_TRUE(passesThroughConvexBody(false, ball, otherSpeed));
+            }
+        }
     }
 }
 

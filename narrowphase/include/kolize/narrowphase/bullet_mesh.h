@@ -24,33 +24,32 @@
 /// their intersecting pairs: a separated point within Bullet's breaking threshold of a
 /// penetrating one would replace it in the manifold, getCacheEntry). Bullet's closest-point
 /// queries (contactTest, contactPairTest) with the callback's m_closestDistanceThreshold get
-/// the same separated contacts up to that distance, with or without a contact margin. The intersecting pairs are
-/// grouped into patches (pairs whose triangles share a vertex index on either mesh). Per patch, the
-/// normal n and the depth come from a separating-axis test on the patch's own triangles: the
-/// candidate directions are their face normals (A's outward, B's reversed; outward is the winding's
-/// side for a closed mesh, the side away from the body's origin for an open one, and for
-/// btBvhTriangleMeshShape scenery, which is two-sided as in Bullet, the side towards the
-/// mesh body's origin: a bowl wound either way holds what falls in; the 64 with the longest
-/// intersections) and NARROWPHASE.md's `normalize(sum of w (n_A - n_B))` (w the segment's
-/// length, the square root of the overlap area for coplanar pairs); the one along which A's
-/// patch vertices and B's overlap least is n (from A towards B), the overlap is the depth.
-/// For a box resting on a face this is that face's normal and the exact overlap, also when
-/// the box is tilted so that only a corner or an edge goes in (where the weighted sum alone
-/// tilts by the side faces' share). The depth is local (v1): it sees only the touched
-/// triangles.
-/// The pairs are taken in (A's triangle, B's triangle) order, so the contacts depend on the
-/// set of pairs only (not on the order a query found them in: mesh_stages.h may skip the tree).
-/// Up to 4 points per manifold are chosen from the intersection points of every patch (and the near
-/// pairs' points): the deepest, the farthest from it, then the two that maximise the spanned area
-/// (Bullet's sortCachedPoints rule). Each point carries its patch's normal and depth, and the
-/// triangle ids of its pair through setShapeIdentifiersA/B(0, triangle) (scenery: its part and
-/// triangle). The manifold is persistent: Bullet's refreshContactPoints() drops the points
-/// that moved apart, as for its own algorithms. A body at rest is mostly held by these kept
-/// points (the solver leaves it touching or a hair apart, where the exact test finds no
-/// new pair); contactTest/contactPairTest then report nothing until the meshes touch. When the
-/// exact test finds the meshes apart, a kept point's distance (recomputed by Bullet from where
-/// the point was on the bodies) reads as touching (0) at most: no penetration is claimed
-/// between meshes that do not intersect, so nothing is pushed apart that is not in contact.
+/// the same separated contacts up to that distance, with or without a contact margin. The
+/// intersecting pairs are grouped into patches (pairs whose triangles share a vertex index on
+/// either mesh). Per patch, the normal n and the depth come from a separating-axis test on the
+/// patch's own triangles: the candidate directions are their face normals (A's outward, B's
+/// reversed; outward is the winding's side for a closed mesh, the side away from the body's origin
+/// for an open one, and for btBvhTriangleMeshShape scenery, which is two-sided as in Bullet, the
+/// side towards the mesh body's origin: a bowl wound either way holds what falls in; the 64 with
+/// the longest intersections) and NARROWPHASE.md's `normalize(sum of w (n_A - n_B))` (w the
+/// segment's length, the square root of the overlap area for coplanar pairs); the one along which
+/// A's patch vertices and B's overlap least is n (from A towards B), the overlap is the depth. For
+/// a box resting on a face this is that face's normal and the exact overlap, also when the box is
+/// tilted so that only a corner or an edge goes in (where the weighted sum alone tilts by the side
+/// faces' share). The depth is local (v1): it sees only the touched triangles. The pairs are taken
+/// in (A's triangle, B's triangle) order, so the contacts depend on the set of pairs only (not on
+/// the order a query found them in: mesh_stages.h may skip the tree). Up to 4 points per manifold
+/// are chosen from the intersection points of every patch (and the near pairs' points): the
+/// deepest, the farthest from it, then the two that maximise the spanned area (Bullet's
+/// sortCachedPoints rule). Each point carries its patch's normal and depth, and the triangle ids of
+/// its pair through setShapeIdentifiersA/B(0, triangle) (scenery: its part and triangle). The
+/// manifold is persistent: Bullet's refreshContactPoints() drops the points that moved apart, as
+/// for its own algorithms. A body at rest is mostly held by these kept points (the solver leaves it
+/// touching or a hair apart, where the exact test finds no new pair); contactTest/contactPairTest
+/// then report nothing until the meshes touch. When the exact test finds the meshes apart, a kept
+/// point's distance (recomputed by Bullet from where the point was on the bodies) reads as touching
+/// (0) at most: no penetration is claimed between meshes that do not intersect, so nothing is
+/// pushed apart that is not in contact.
 ///
 /// Continuous collision: the mesh algorithms' calculateTimeOfImpact is the exact first
 /// contact of the two moving meshes (kolize::ccd::meshCcd; see MeshContactAlgorithm), and
@@ -256,9 +255,19 @@ class MeshMeshAlgorithm : public MeshContactAlgorithm {
 
 /// A convex shape against a MeshShape (either order): the tree gives the triangles in the
 /// convex's box, Bullet's convex-triangle algorithm the contacts. Never the SDF path.
-/// Time of impact: 1. A fast convex body gets Bullet's own CCD (its swept sphere in
+/// Time of impact (calculateTimeOfImpact): as for two meshes (MeshContactAlgorithm: the same
+/// step, pieces, rules and result), the mesh against a closed triangle surface that encloses
+/// the convex shape with its margin: exactly its faces for a box or another polytope
+/// (scaled out by its margin where the margin rounds it); for a round shape (a sphere,
+/// capsule, cylinder, cone) a polytope whose faces lie at or just beyond it and whose vertices
+/// stand off it by at most 4% of its radius; the box of its supports for a flat one (a
+/// triangle). Never later than the first contact with the shape itself,
+/// early by at most that enclosure. The surface is built on the first call (122 supporting
+/// vertices and their hull) and rebuilt when the shape changes so that it no longer
+/// encloses it. "Touching at the start" means the pair's manifold holds points. A fast
+/// convex body also gets Bullet's own CCD (its swept sphere in
 /// btDiscreteDynamicsWorld::integrateTransforms sweeps through MeshShape's
-/// processAllTriangles); a fast mesh body against a convex one has none yet.
+/// processAllTriangles, the mesh held where it is).
 class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
   public:
     ConvexMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -286,8 +295,10 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
     };
 
   private:
+    struct Ccd;  ///< the time of impact's surface and buffers, made on the first call
     btConvexTriangleCallback triangles_;
     bool meshFirst_;
+    std::unique_ptr<Ccd> ccd_;
 };
 
 /// A MeshShape against Bullet's triangle-mesh scenery (btBvhTriangleMeshShape, any order):

@@ -63,23 +63,28 @@ struct MeshCcdCounters {
 ///    needsCollision and needsResponse, as in Bullet's btClosestNotMeConvexResultCallback;
 /// 3. each such pair, once, in world order: the pair's own mesh algorithm when the pair
 ///    cache holds one (its last processCollision is this step's), else one made for the
-///    question and freed, computes calculateTimeOfImpact (pairs without a kolize mesh
-///    algorithm, e.g. a mesh against a convex shape, are skipped). A time of impact toi < 1
+///    question and freed, computes calculateTimeOfImpact: MeshMeshAlgorithm,
+///    BvhMeshAlgorithm (scenery) and ConvexMeshAlgorithm (a convex body, dynamic or not; its
+///    time of impact against a surface enclosing the convex shape); other pairs are
+///    skipped. A time of impact toi < 1
 ///    limits each body of the pair to h' = min(1, toi + penetration / L) of the step, L the
 ///    body's motion length (its origin's motion plus its turn times its bounding radius):
 ///    it goes `penetration` past the first contact (settings);
 /// 4. btDiscreteDynamicsWorld::integrateTransforms runs as usual (Bullet's swept sphere for
-///    convex bodies, unchanged);
+///    convex bodies, unchanged), over the convex bodies first and then the others, each
+///    group in world order: a convex body's swept sphere then meets the mesh bodies where
+///    they start the step (a mesh box pushing a ball at speed, integrated first, would stand
+///    in front of the ball, which Bullet would stop against the box's back);
 /// 5. every body limited in 3 to h' < 1 is then put where Bullet's own CCD would put it, its
-///    predictIntegratedTransform over h' times the step, via proceedToTransform. Its
+///    predictIntegratedTransform over h' times the step, via proceedToTransform (a convex
+///    body that Bullet's swept sphere stopped in 4 after a shorter motion stays there). Its
 ///    velocity is kept: the collision response happens in the next step, from the contact
 ///    made there (as in Bullet's integrateTransforms). Its getHitFraction() holds the
 ///    smallest toi until the next step.
 /// The thesis moved the object back to the time of impact after the step; here the body is
 /// not moved past it in the first place, which is what Bullet's integrator does.
 ///
-/// Not covered: compound shapes with MeshShape children (their children get no CCD), a fast
-/// mesh body against a convex body (ConvexMeshAlgorithm has no time of impact), and the
+/// Not covered: compound shapes with MeshShape children (their children get no CCD) and the
 /// multithreaded btDiscreteDynamicsWorldMt. Two fast mesh bodies are handled as a pair, each
 /// moving. Deterministic: the result does not depend on the broadphase's report order.
 /// Cost per fast body: one aabbTest and, per pair found, meshCcd over both whole meshes.
@@ -112,9 +117,13 @@ class MeshCcdWorld : public btDiscreteDynamicsWorld {
         btRigidBody* body;
         btTransform transform;
         btScalar hitFraction;
+        double fraction;       ///< of the step
+        btVector3 start, end;  ///< the origin at the start and the end of the whole step
     };
     std::vector<Clamp> clamped_;
     std::map<const btCollisionObject*, double> allowed_;
+    btAlignedObjectArray<btRigidBody*> integrationOrder_;  ///< convex bodies first
+    btAlignedObjectArray<btRigidBody*> worldOrder_;
 };
 
 }  // namespace kolize
