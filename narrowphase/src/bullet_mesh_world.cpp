@@ -4,6 +4,9 @@
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
 #include <BulletCollision/CollisionDispatch/btCollisionObjectWrapper.h>
+#include <BulletCollision/CollisionDispatch/btManifoldResult.h>
+#include <BulletCollision/CollisionShapes/btCompoundShape.h>
+#include <LinearMath/btAabbUtil2.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <algorithm>
@@ -24,12 +27,51 @@ void checkSettings(const MeshCcdWorldSettings& settings) {
     }
 }
 
-const MeshShape* meshShapeOf(const btCollisionObject& object) {
-    const btCollisionShape* shape = object.getCollisionShape();
+const MeshShape* meshShape(const btCollisionShape* shape) {
     if (!shape || shape->getShapeType() != CUSTOM_CONCAVE_SHAPE_TYPE) {
         return nullptr;
     }
     return dynamic_cast<const MeshShape*>(shape);
+}
+
+const MeshShape* meshShapeOf(const btCollisionObject& object) {
+    return meshShape(object.getCollisionShape());
+}
+
+/// The shapes that are not compounds in `shape`, with their transforms in its frame
+/// (compounds in compounds flattened; `shape` itself when it is not a compound).
+void leavesOf(const btCollisionShape* shape, const btTransform& local,
+              std::vector<MeshCcdWorld::Leaf>& out, int depth = 0) {
+    if (!shape) {
+        return;
+    }
+    if (shape->getShapeType() != COMPOUND_SHAPE_PROXYTYPE || depth > 64) {
+        out.push_back({shape, local});
+        return;
+    }
+    const auto* compound = static_cast<const btCompoundShape*>(shape);
+    for (int i = 0; i < compound->getNumChildShapes(); ++i) {
+        leavesOf(compound->getChildShape(i), local * compound->getChildTransform(i), out,
+                 depth + 1);
+    }
+}
+
+bool hasMeshLeaf(const btCollisionShape* shape, std::vector<MeshCcdWorld::Leaf>& scratch) {
+    scratch.clear();
+    btTransform identity;
+    identity.setIdentity();
+    leavesOf(shape, identity, scratch);
+    for (const MeshCcdWorld::Leaf& leaf : scratch) {
+        if (meshShape(leaf.shape)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool isCompound(const btCollisionObject& object) {
+    return object.getCollisionShape() &&
+           object.getCollisionShape()->getShapeType() == COMPOUND_SHAPE_PROXYTYPE;
 }
 
 class CollectObjects : public btBroadphaseAabbCallback {
@@ -43,6 +85,16 @@ class CollectObjects : public btBroadphaseAabbCallback {
   private:
     std::vector<btCollisionObject*>& out_;
 };
+
+/// Whether the boxes of `leaf` over the step of `object` (start and end) overlap the other's.
+void sweptLeafBox(const btCollisionObject& object, const btTransform& end,
+                  const MeshCcdWorld::Leaf& leaf, btVector3& lo, btVector3& hi) {
+    btVector3 endLo, endHi;
+    leaf.shape->getAabb(object.getWorldTransform() * leaf.local, lo, hi);
+    leaf.shape->getAabb(end * leaf.local, endLo, endHi);
+    lo.setMin(endLo);
+    hi.setMax(endHi);
+}
 
 bool filtersPass(const btCollisionObject& a, const btCollisionObject& b) {
     const btBroadphaseProxy* pa = a.getBroadphaseHandle();
@@ -78,7 +130,101 @@ void MeshCcdWorld::setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
     settings_ = settings;
 }
 
+void MeshCcdWorld::limit(btCollisionObject* a, btCollisionObject* b, btScalar toi) {
+    for (btCollisionObject* object : {a, b}) {
+        const double length = motionLength(*object);
+        const double fraction =
+            length > 0 ? std::min(1.0, double(toi) + settings_.penetration / length) : 1.0;
+        auto [it, inserted] = allowed_.emplace(object, fraction);
+        if (!inserted) {
+            it->second = std::min(it->second, fraction);
+        }
+    }
+}
+
+void MeshCcdWorld::ProxyObject::take(const btCollisionObject& object, const Leaf& leaf,
+                                     const btTransform& end) {
+    setCollisionFlags(object.getCollisionFlags());
+    forceActivationState(object.getActivationState());
+    setCollisionShape(const_cast<btCollisionShape*>(leaf.shape));
+    setWorldTransform(object.getWorldTransform() * leaf.local);
+    setInterpolationWorldTransform(end * leaf.local);
+    setCcdMotionThreshold(object.getCcdMotionThreshold());
+    setHitFraction(1);
+}
+
+void MeshCcdWorld::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* b) {
+    btTransform identity;
+    identity.setIdentity();
+    leavesA_.clear();
+    leavesB_.clear();
+    leavesOf(a->getCollisionShape(), identity, leavesA_);
+    leavesOf(b->getCollisionShape(), identity, leavesB_);
+    auto ends = [](const btCollisionObject& object) -> const btTransform& {
+        const auto* body = btRigidBody::upcast(&object);
+        return body && body->isActive() && !body->isStaticOrKinematicObject()
+                   ? object.getInterpolationWorldTransform()
+                   : object.getWorldTransform();
+    };
+    const btTransform& endA = ends(*a);
+    const btTransform& endB = ends(*b);
+    btScalar earliest = 1;
+    for (const Leaf& leafA : leavesA_) {
+        btVector3 loA, hiA;
+        sweptLeafBox(*a, endA, leafA, loA, hiA);
+        for (const Leaf& leafB : leavesB_) {
+            // Pairs with a MeshShape and a shape kolize's algorithms take (the mesh
+            // algorithms' and ConvexMeshAlgorithm's); convex pairs are Bullet's business.
+            if (!meshShape(leafA.shape) && !meshShape(leafB.shape)) {
+                continue;
+            }
+            btVector3 loB, hiB;
+            sweptLeafBox(*b, endB, leafB, loB, hiB);
+            if (!TestAabbAgainstAabb2(loA, hiA, loB, hiB)) {
+                continue;
+            }
+            proxyA_.take(*a, leafA, endA);
+            proxyB_.take(*b, leafB, endB);
+            const btCollisionObjectWrapper wrapA(nullptr, proxyA_.getCollisionShape(), &proxyA_,
+                                                 proxyA_.getWorldTransform(), -1, -1);
+            const btCollisionObjectWrapper wrapB(nullptr, proxyB_.getCollisionShape(), &proxyB_,
+                                                 proxyB_.getWorldTransform(), -1, -1);
+            btCollisionAlgorithm* algorithm =
+                m_dispatcher1->findAlgorithm(&wrapA, &wrapB, nullptr, BT_CONTACT_POINT_ALGORITHMS);
+            if (!algorithm) {
+                continue;
+            }
+            if (dynamic_cast<MeshContactAlgorithm*>(algorithm) ||
+                dynamic_cast<ConvexMeshAlgorithm*>(algorithm)) {
+                ++counters_.pairs;
+                // The contacts at the start first: a pair that touches is left to them
+                // unless it drives in (the algorithms' rule), as for a pair in the cache.
+                btManifoldResult result(&wrapA, &wrapB);
+                algorithm->processCollision(&wrapA, &wrapB, getDispatchInfo(), &result);
+                const btScalar toi = algorithm->calculateTimeOfImpact(&proxyA_, &proxyB_,
+                                                                      getDispatchInfo(), nullptr);
+                earliest = std::min(earliest, toi);
+            }
+            algorithm->~btCollisionAlgorithm();
+            m_dispatcher1->freeCollisionAlgorithm(algorithm);
+        }
+    }
+    if (earliest < 1) {
+        for (btCollisionObject* object : {a, b}) {
+            if (object->getHitFraction() > earliest && btRigidBody::upcast(object) &&
+                object->isActive() && !object->isStaticOrKinematicObject()) {
+                object->setHitFraction(earliest);
+            }
+        }
+        limit(a, b, earliest);
+    }
+}
+
 void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
+    if (isCompound(*a) || isCompound(*b)) {
+        compoundTimeOfImpact(a, b);
+        return;
+    }
     btBroadphasePair* pair =
         getPairCache()->findPair(a->getBroadphaseHandle(), b->getBroadphaseHandle());
     btCollisionAlgorithm* algorithm = pair ? pair->m_algorithm : nullptr;
@@ -103,15 +249,7 @@ void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
         // Both bodies go `penetration` past the time of impact, to make their contact.
         const btScalar toi = algorithm->calculateTimeOfImpact(a, b, getDispatchInfo(), nullptr);
         if (toi < 1) {
-            for (btCollisionObject* object : {a, b}) {
-                const double length = motionLength(*object);
-                const double fraction =
-                    length > 0 ? std::min(1.0, double(toi) + settings_.penetration / length) : 1.0;
-                auto [it, inserted] = allowed_.emplace(object, fraction);
-                if (!inserted) {
-                    it->second = std::min(it->second, fraction);
-                }
-            }
+            limit(a, b, toi);
         }
     }
     if (temporary) {
@@ -137,8 +275,9 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
         }
         for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
             btRigidBody* body = m_nonStaticRigidBodies[i];
-            const MeshShape* shape = meshShapeOf(*body);
-            if (!shape || !exceedsCcdMotionThreshold(*body)) {
+            const btCollisionShape* shape = body->getCollisionShape();
+            if (!shape || !exceedsCcdMotionThreshold(*body) ||
+                !(meshShapeOf(*body) || (isCompound(*body) && hasMeshLeaf(shape, leavesA_)))) {
                 continue;
             }
             ++counters_.bodies;

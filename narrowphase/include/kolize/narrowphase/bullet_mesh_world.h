@@ -23,6 +23,7 @@
 #include "kolize/narrowphase/bullet_mesh.h"
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
+#include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <cstddef>
 #include <map>
@@ -84,10 +85,15 @@ struct MeshCcdCounters {
 /// The thesis moved the object back to the time of impact after the step; here the body is
 /// not moved past it in the first place, which is what Bullet's integrator does.
 ///
-/// Not covered: compound shapes with MeshShape children (their children get no CCD) and the
-/// multithreaded btDiscreteDynamicsWorldMt. Two fast mesh bodies are handled as a pair, each
-/// moving. Deterministic: the result does not depend on the broadphase's report order.
-/// Cost per fast body: one aabbTest and, per pair found, meshCcd over both whole meshes.
+/// Compounds: a body whose btCompoundShape holds a MeshShape (at any depth) is a mesh body
+/// here, and a pair with a compound on either side takes every pair of their leaves (the
+/// shapes that are not compounds) with a MeshShape on one side whose boxes over the step
+/// meet, each through an algorithm made for it that first makes its contacts at the start
+/// (so the in-contact rule holds as for a pair in the cache); the earliest time limits both
+/// bodies. Not covered: the multithreaded btDiscreteDynamicsWorldMt. Two fast mesh bodies are
+/// handled as a pair, each moving. Deterministic: the result does not depend on the broadphase's
+/// report order. Cost per fast body: one aabbTest and, per pair found, meshCcd over both whole
+/// meshes.
 class MeshCcdWorld : public btDiscreteDynamicsWorld {
   public:
     /// As btDiscreteDynamicsWorld's. Throws std::invalid_argument for bad `settings`.
@@ -102,12 +108,33 @@ class MeshCcdWorld : public btDiscreteDynamicsWorld {
     /// What the last internal step's mesh CCD did.
     const MeshCcdCounters& lastMeshCcd() const { return counters_; }
 
+    /// A shape that is not a compound inside a body's shape, with its transform in the body's
+    /// frame (the body's shape itself when it is not a compound).
+    struct Leaf {
+        const btCollisionShape* shape;
+        btTransform local;
+    };
+
   protected:
     void integrateTransforms(btScalar timeStep) override;
 
   private:
+    /// A leaf of a compound as a body of its own, for the algorithms' time of impact (a
+    /// btRigidBody: what they read of the real one, a rigid body or not, is copied).
+    struct ProxyObject : btRigidBody {
+        ProxyObject() : btRigidBody(btRigidBodyConstructionInfo(1, nullptr, nullptr)) {}
+        /// Becomes `leaf` of `object` (its flags, activation and CCD threshold), moving from
+        /// the object's world transform to `end`.
+        void take(const btCollisionObject& object, const Leaf& leaf, const btTransform& end);
+    };
     /// One pair's time of impact; lowers the fractions its bodies may move (allowed_).
     void timeOfImpact(btCollisionObject* a, btCollisionObject* b);
+    /// The same for a pair with a compound: every pair of their leaves with a MeshShape
+    /// whose boxes over the step meet, through an algorithm made for it (contacts at the
+    /// start first, then the time of impact).
+    void compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* b);
+    /// Both bodies may go `penetration` past `toi` (allowed_).
+    void limit(btCollisionObject* a, btCollisionObject* b, btScalar toi);
 
     MeshCcdWorldSettings settings_;
     MeshCcdCounters counters_;
@@ -124,6 +151,8 @@ class MeshCcdWorld : public btDiscreteDynamicsWorld {
     std::map<const btCollisionObject*, double> allowed_;
     btAlignedObjectArray<btRigidBody*> integrationOrder_;  ///< convex bodies first
     btAlignedObjectArray<btRigidBody*> worldOrder_;
+    std::vector<Leaf> leavesA_, leavesB_;
+    ProxyObject proxyA_, proxyB_;
 };
 
 }  // namespace kolize
