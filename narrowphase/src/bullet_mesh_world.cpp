@@ -1,5 +1,7 @@
 #include "kolize/narrowphase/bullet_mesh_world.h"
 
+#include "mesh_ccd_pass.h"
+
 #include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
@@ -16,6 +18,9 @@
 #include <string>
 
 namespace kolize {
+
+using detail::Leaf;
+using detail::MeshCcdPass;
 
 namespace {
 
@@ -40,8 +45,8 @@ const MeshShape* meshShapeOf(const btCollisionObject& object) {
 
 /// The shapes that are not compounds in `shape`, with their transforms in its frame
 /// (compounds in compounds flattened; `shape` itself when it is not a compound).
-void leavesOf(const btCollisionShape* shape, const btTransform& local,
-              std::vector<MeshCcdWorld::Leaf>& out, int depth = 0) {
+void leavesOf(const btCollisionShape* shape, const btTransform& local, std::vector<Leaf>& out,
+              int depth = 0) {
     if (!shape) {
         return;
     }
@@ -56,12 +61,12 @@ void leavesOf(const btCollisionShape* shape, const btTransform& local,
     }
 }
 
-bool hasMeshLeaf(const btCollisionShape* shape, std::vector<MeshCcdWorld::Leaf>& scratch) {
+bool hasMeshLeaf(const btCollisionShape* shape, std::vector<Leaf>& scratch) {
     scratch.clear();
     btTransform identity;
     identity.setIdentity();
     leavesOf(shape, identity, scratch);
-    for (const MeshCcdWorld::Leaf& leaf : scratch) {
+    for (const Leaf& leaf : scratch) {
         if (meshShape(leaf.shape)) {
             return true;
         }
@@ -87,8 +92,8 @@ class CollectObjects : public btBroadphaseAabbCallback {
 };
 
 /// Whether the boxes of `leaf` over the step of `object` (start and end) overlap the other's.
-void sweptLeafBox(const btCollisionObject& object, const btTransform& end,
-                  const MeshCcdWorld::Leaf& leaf, btVector3& lo, btVector3& hi) {
+void sweptLeafBox(const btCollisionObject& object, const btTransform& end, const Leaf& leaf,
+                  btVector3& lo, btVector3& hi) {
     btVector3 endLo, endHi;
     leaf.shape->getAabb(object.getWorldTransform() * leaf.local, lo, hi);
     leaf.shape->getAabb(end * leaf.local, endLo, endHi);
@@ -118,19 +123,16 @@ double motionLength(const btCollisionObject& object) {
 
 }  // namespace
 
-MeshCcdWorld::MeshCcdWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
-                           btConstraintSolver* solver, btCollisionConfiguration* configuration,
-                           const MeshCcdWorldSettings& settings)
-    : btDiscreteDynamicsWorld(dispatcher, broadphase, solver, configuration), settings_(settings) {
+MeshCcdPass::MeshCcdPass(const MeshCcdWorldSettings& settings) : settings_(settings) {
     checkSettings(settings);
 }
 
-void MeshCcdWorld::setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
+void MeshCcdPass::setSettings(const MeshCcdWorldSettings& settings) {
     checkSettings(settings);
     settings_ = settings;
 }
 
-void MeshCcdWorld::limit(btCollisionObject* a, btCollisionObject* b, btScalar toi) {
+void MeshCcdPass::limit(btCollisionObject* a, btCollisionObject* b, btScalar toi) {
     for (btCollisionObject* object : {a, b}) {
         const double length = motionLength(*object);
         const double fraction =
@@ -142,8 +144,8 @@ void MeshCcdWorld::limit(btCollisionObject* a, btCollisionObject* b, btScalar to
     }
 }
 
-void MeshCcdWorld::ProxyObject::take(const btCollisionObject& object, const Leaf& leaf,
-                                     const btTransform& end) {
+void MeshCcdPass::ProxyObject::take(const btCollisionObject& object, const Leaf& leaf,
+                                    const btTransform& end) {
     setCollisionFlags(object.getCollisionFlags());
     forceActivationState(object.getActivationState());
     setCollisionShape(const_cast<btCollisionShape*>(leaf.shape));
@@ -153,7 +155,7 @@ void MeshCcdWorld::ProxyObject::take(const btCollisionObject& object, const Leaf
     setHitFraction(1);
 }
 
-void MeshCcdWorld::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* b) {
+void MeshCcdPass::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* b) {
     btTransform identity;
     identity.setIdentity();
     leavesA_.clear();
@@ -189,8 +191,8 @@ void MeshCcdWorld::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject*
                                                  proxyA_.getWorldTransform(), -1, -1);
             const btCollisionObjectWrapper wrapB(nullptr, proxyB_.getCollisionShape(), &proxyB_,
                                                  proxyB_.getWorldTransform(), -1, -1);
-            btCollisionAlgorithm* algorithm =
-                m_dispatcher1->findAlgorithm(&wrapA, &wrapB, nullptr, BT_CONTACT_POINT_ALGORITHMS);
+            btCollisionAlgorithm* algorithm = world_->getDispatcher()->findAlgorithm(
+                &wrapA, &wrapB, nullptr, BT_CONTACT_POINT_ALGORITHMS);
             if (!algorithm) {
                 continue;
             }
@@ -200,13 +202,13 @@ void MeshCcdWorld::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject*
                 // The contacts at the start first: a pair that touches is left to them
                 // unless it drives in (the algorithms' rule), as for a pair in the cache.
                 btManifoldResult result(&wrapA, &wrapB);
-                algorithm->processCollision(&wrapA, &wrapB, getDispatchInfo(), &result);
-                const btScalar toi = algorithm->calculateTimeOfImpact(&proxyA_, &proxyB_,
-                                                                      getDispatchInfo(), nullptr);
+                algorithm->processCollision(&wrapA, &wrapB, world_->getDispatchInfo(), &result);
+                const btScalar toi = algorithm->calculateTimeOfImpact(
+                    &proxyA_, &proxyB_, world_->getDispatchInfo(), nullptr);
                 earliest = std::min(earliest, toi);
             }
             algorithm->~btCollisionAlgorithm();
-            m_dispatcher1->freeCollisionAlgorithm(algorithm);
+            world_->getDispatcher()->freeCollisionAlgorithm(algorithm);
         }
     }
     if (earliest < 1) {
@@ -220,13 +222,13 @@ void MeshCcdWorld::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject*
     }
 }
 
-void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
+void MeshCcdPass::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
     if (isCompound(*a) || isCompound(*b)) {
         compoundTimeOfImpact(a, b);
         return;
     }
     btBroadphasePair* pair =
-        getPairCache()->findPair(a->getBroadphaseHandle(), b->getBroadphaseHandle());
+        world_->getPairCache()->findPair(a->getBroadphaseHandle(), b->getBroadphaseHandle());
     btCollisionAlgorithm* algorithm = pair ? pair->m_algorithm : nullptr;
     bool temporary = false;
     if (algorithm) {
@@ -239,33 +241,36 @@ void MeshCcdWorld::timeOfImpact(btCollisionObject* a, btCollisionObject* b) {
                                              a->getWorldTransform(), -1, -1);
         const btCollisionObjectWrapper wrapB(nullptr, b->getCollisionShape(), b,
                                              b->getWorldTransform(), -1, -1);
-        algorithm =
-            m_dispatcher1->findAlgorithm(&wrapA, &wrapB, nullptr, BT_CONTACT_POINT_ALGORITHMS);
+        algorithm = world_->getDispatcher()->findAlgorithm(&wrapA, &wrapB, nullptr,
+                                                           BT_CONTACT_POINT_ALGORITHMS);
         temporary = algorithm != nullptr;
     }
     if (dynamic_cast<MeshContactAlgorithm*>(algorithm) ||
         dynamic_cast<ConvexMeshAlgorithm*>(algorithm)) {
         ++counters_.pairs;
         // Both bodies go `penetration` past the time of impact, to make their contact.
-        const btScalar toi = algorithm->calculateTimeOfImpact(a, b, getDispatchInfo(), nullptr);
+        const btScalar toi =
+            algorithm->calculateTimeOfImpact(a, b, world_->getDispatchInfo(), nullptr);
         if (toi < 1) {
             limit(a, b, toi);
         }
     }
     if (temporary) {
         algorithm->~btCollisionAlgorithm();
-        m_dispatcher1->freeCollisionAlgorithm(algorithm);
+        world_->getDispatcher()->freeCollisionAlgorithm(algorithm);
     }
 }
 
-void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
+void MeshCcdPass::before(btDiscreteDynamicsWorld& world, btScalar timeStep) {
+    world_ = &world;
+    btAlignedObjectArray<btRigidBody*>& bodies = world.getNonStaticRigidBodies();
     counters_ = MeshCcdCounters{};
     clamped_.clear();
     pairs_.clear();
     allowed_.clear();
-    if (getDispatchInfo().m_useContinuous) {
-        for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
-            btRigidBody* body = m_nonStaticRigidBodies[i];
+    if (world_->getDispatchInfo().m_useContinuous) {
+        for (int i = 0; i < bodies.size(); ++i) {
+            btRigidBody* body = bodies[i];
             body->setHitFraction(1);
             if (body->isActive() && !body->isStaticOrKinematicObject()) {
                 btTransform predicted;
@@ -273,8 +278,8 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
                 body->setInterpolationWorldTransform(predicted);
             }
         }
-        for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
-            btRigidBody* body = m_nonStaticRigidBodies[i];
+        for (int i = 0; i < bodies.size(); ++i) {
+            btRigidBody* body = bodies[i];
             const btCollisionShape* shape = body->getCollisionShape();
             if (!shape || !exceedsCcdMotionThreshold(*body) ||
                 !(meshShapeOf(*body) || (isCompound(*body) && hasMeshLeaf(shape, leavesA_)))) {
@@ -288,11 +293,11 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
             hi.setMax(endHi);
             found_.clear();
             CollectObjects collect(found_);
-            getBroadphase()->aabbTest(lo, hi, collect);
+            world_->getBroadphase()->aabbTest(lo, hi, collect);
             for (btCollisionObject* other : found_) {
                 if (other == body || !filtersPass(*body, *other) ||
-                    !m_dispatcher1->needsCollision(body, other) ||
-                    !m_dispatcher1->needsResponse(body, other)) {
+                    !world_->getDispatcher()->needsCollision(body, other) ||
+                    !world_->getDispatcher()->needsResponse(body, other)) {
                     continue;
                 }
                 const int x = body->getWorldArrayIndex();
@@ -304,10 +309,11 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
         std::sort(pairs_.begin(), pairs_.end());
         pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
         for (const auto& [x, y] : pairs_) {
-            timeOfImpact(m_collisionObjects[x], m_collisionObjects[y]);
+            timeOfImpact(world_->getCollisionObjectArray()[x],
+                         world_->getCollisionObjectArray()[y]);
         }
-        for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
-            btRigidBody* body = m_nonStaticRigidBodies[i];
+        for (int i = 0; i < bodies.size(); ++i) {
+            btRigidBody* body = bodies[i];
             const btScalar hit = body->getHitFraction();
             if (hit >= 1 || !body->isActive() || body->isStaticOrKinematicObject()) {
                 continue;
@@ -330,8 +336,8 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
     // pass's business (the pairs above, which see both motions). Same order otherwise.
     integrationOrder_.clear();
     for (int convex = 1; convex >= 0; --convex) {
-        for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
-            btRigidBody* body = m_nonStaticRigidBodies[i];
+        for (int i = 0; i < bodies.size(); ++i) {
+            btRigidBody* body = bodies[i];
             const bool isConvex =
                 body->getCollisionShape() && body->getCollisionShape()->isConvex();
             if (isConvex == bool(convex)) {
@@ -339,10 +345,12 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
             }
         }
     }
-    worldOrder_.copyFromArray(m_nonStaticRigidBodies);
-    m_nonStaticRigidBodies.copyFromArray(integrationOrder_);
-    btDiscreteDynamicsWorld::integrateTransforms(timeStep);
-    m_nonStaticRigidBodies.copyFromArray(worldOrder_);
+    worldOrder_.copyFromArray(bodies);
+    bodies.copyFromArray(integrationOrder_);
+}
+
+void MeshCcdPass::after(btDiscreteDynamicsWorld& world) {
+    world.getNonStaticRigidBodies().copyFromArray(worldOrder_);
     // Bullet's integrator reset every hit fraction and moved these bodies the whole step, or,
     // for a convex body its swept sphere stopped (hit fraction 0 after it), part of it:
     // that body keeps the shorter of the two motions.
@@ -359,6 +367,61 @@ void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
         clamp.body->setHitFraction(clamp.hitFraction);
         ++counters_.clamped;
     }
+}
+
+MeshCcdWorld::MeshCcdWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                           btConstraintSolver* solver, btCollisionConfiguration* configuration,
+                           const MeshCcdWorldSettings& settings)
+    : btDiscreteDynamicsWorld(dispatcher, broadphase, solver, configuration),
+      pass_(std::make_unique<detail::MeshCcdPass>(settings)) {}
+
+MeshCcdWorld::~MeshCcdWorld() = default;
+
+const MeshCcdWorldSettings& MeshCcdWorld::meshCcdSettings() const {
+    return pass_->settings();
+}
+
+void MeshCcdWorld::setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
+    pass_->setSettings(settings);
+}
+
+const MeshCcdCounters& MeshCcdWorld::lastMeshCcd() const {
+    return pass_->counters();
+}
+
+void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
+    pass_->before(*this, timeStep);
+    btDiscreteDynamicsWorld::integrateTransforms(timeStep);
+    pass_->after(*this);
+}
+
+MeshCcdWorldMt::MeshCcdWorldMt(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                               btConstraintSolverPoolMt* solverPool,
+                               btConstraintSolver* constraintSolverMt,
+                               btCollisionConfiguration* configuration,
+                               const MeshCcdWorldSettings& settings)
+    : btDiscreteDynamicsWorldMt(dispatcher, broadphase, solverPool, constraintSolverMt,
+                                configuration),
+      pass_(std::make_unique<detail::MeshCcdPass>(settings)) {}
+
+MeshCcdWorldMt::~MeshCcdWorldMt() = default;
+
+const MeshCcdWorldSettings& MeshCcdWorldMt::meshCcdSettings() const {
+    return pass_->settings();
+}
+
+void MeshCcdWorldMt::setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
+    pass_->setSettings(settings);
+}
+
+const MeshCcdCounters& MeshCcdWorldMt::lastMeshCcd() const {
+    return pass_->counters();
+}
+
+void MeshCcdWorldMt::integrateTransforms(btScalar timeStep) {
+    pass_->before(*this, timeStep);
+    btDiscreteDynamicsWorldMt::integrateTransforms(timeStep);
+    pass_->after(*this);
 }
 
 }  // namespace kolize

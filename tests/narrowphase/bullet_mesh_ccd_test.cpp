@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <btBulletCollisionCommon.h>
+#include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolverMt.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <gtest/gtest.h>
@@ -535,6 +536,7 @@ enum class Method {
     kMeshCcdWorldOff,  ///< kolize::MeshCcdWorld, no CCD threshold (CCD off)
     /// kolize::MeshCcdWorld, each body a btCompoundShape of the mesh box and a 5 cm ball
     kMeshCcdWorldCompounds,
+    kMeshCcdWorldMt,  ///< kolize::MeshCcdWorldMt (Bullet's multithreaded world), as kMeshCcdWorld
     kBulletCcdMeshBody,    ///< btDiscreteDynamicsWorld, Bullet's CCD settings on mesh bodies
     kBulletCcdConvexBody,  ///< btDiscreteDynamicsWorld, btBoxShape bodies, Bullet's swept sphere
     kBulletCcdConvexBodySmallSphere,  ///< the same with a 1 mm swept sphere
@@ -548,6 +550,8 @@ const char* name(Method m) {
             return "MeshCcdWorld, CCD off";
         case Method::kMeshCcdWorldCompounds:
             return "MeshCcdWorld, compounds (mesh box + ball)";
+        case Method::kMeshCcdWorldMt:
+            return "MeshCcdWorldMt";
         case Method::kBulletCcdMeshBody:
             return "btDiscreteDynamicsWorld, mesh body";
         case Method::kBulletCcdConvexBody:
@@ -582,8 +586,13 @@ ThrowResult throwAtWall(Method method, WallKind wallKind, double speed, int step
     btDbvtBroadphase broadphase;
     btSequentialImpulseConstraintSolver solver;
     std::unique_ptr<btDiscreteDynamicsWorld> world;
-    if (method == Method::kMeshCcdWorld || method == Method::kMeshCcdWorldOff ||
-        method == Method::kMeshCcdWorldCompounds) {
+    btConstraintSolverPoolMt solverPool(1);
+    btSequentialImpulseConstraintSolverMt solverMt;
+    if (method == Method::kMeshCcdWorldMt) {
+        world = std::make_unique<kolize::MeshCcdWorldMt>(&dispatcher, &broadphase, &solverPool,
+                                                         &solverMt, &configuration);
+    } else if (method == Method::kMeshCcdWorld || method == Method::kMeshCcdWorldOff ||
+               method == Method::kMeshCcdWorldCompounds) {
         world = std::make_unique<MeshCcdWorld>(&dispatcher, &broadphase, &solver, &configuration);
     } else {
         world = std::make_unique<btDiscreteDynamicsWorld>(&dispatcher, &broadphase, &solver,
@@ -673,6 +682,9 @@ ThrowResult throwAtWall(Method method, WallKind wallKind, double speed, int step
         if (auto* ccd = dynamic_cast<MeshCcdWorld*>(world.get())) {
             out.clamped += ccd->lastMeshCcd().clamped;
         }
+        if (auto* ccd = dynamic_cast<kolize::MeshCcdWorldMt*>(world.get())) {
+            out.clamped += ccd->lastMeshCcd().clamped;
+        }
         for (int k = 0; k < kThrown; ++k) {
             const btRigidBody& body = *bodies[k + 1];
             const btTransform& t = body.getWorldTransform();
@@ -710,16 +722,20 @@ TEST(BulletMeshCcdWorld, ThinWallStopsEveryBodyAtEverySpeed) {
         std::printf(" %6.0f m/s", v);
     }
     std::printf("\n");
-    const Method methods[] = {
-        Method::kMeshCcdWorld,        Method::kMeshCcdWorldCompounds,
-        Method::kMeshCcdWorldOff,     Method::kBulletCcdMeshBody,
-        Method::kBulletCcdConvexBody, Method::kBulletCcdConvexBodySmallSphere};
+    const Method methods[] = {Method::kMeshCcdWorld,
+                              Method::kMeshCcdWorldCompounds,
+                              Method::kMeshCcdWorldMt,
+                              Method::kMeshCcdWorldOff,
+                              Method::kBulletCcdMeshBody,
+                              Method::kBulletCcdConvexBody,
+                              Method::kBulletCcdConvexBodySmallSphere};
     const char* wallNames[] = {"static", "kinematic", "scenery", "btBoxShape", "compound"};
     for (Method method : methods) {
         for (WallKind wall : {WallKind::kStaticMesh, WallKind::kKinematicMesh, WallKind::kScenery,
                               WallKind::kConvexBox, WallKind::kCompoundMesh}) {
-            const bool withCcd =
-                method == Method::kMeshCcdWorld || method == Method::kMeshCcdWorldCompounds;
+            const bool withCcd = method == Method::kMeshCcdWorld ||
+                                 method == Method::kMeshCcdWorldCompounds ||
+                                 method == Method::kMeshCcdWorldMt;
             const bool shown = wall == WallKind::kStaticMesh ||
                                (wall == WallKind::kConvexBox && method == Method::kMeshCcdWorldOff);
             if (!withCcd && !shown) {

@@ -23,13 +23,16 @@
 #include "kolize/narrowphase/bullet_mesh.h"
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
-#include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletDynamics/Dynamics/btDiscreteDynamicsWorldMt.h>
 
 #include <cstddef>
-#include <map>
-#include <vector>
+#include <memory>
 
 namespace kolize {
+
+namespace detail {
+class MeshCcdPass;
+}
 
 /// Settings of MeshCcdWorld.
 struct MeshCcdWorldSettings {
@@ -100,59 +103,46 @@ class MeshCcdWorld : public btDiscreteDynamicsWorld {
     MeshCcdWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
                  btConstraintSolver* solver, btCollisionConfiguration* configuration,
                  const MeshCcdWorldSettings& settings = {});
+    ~MeshCcdWorld() override;
 
-    const MeshCcdWorldSettings& meshCcdSettings() const { return settings_; }
+    const MeshCcdWorldSettings& meshCcdSettings() const;
     /// Throws std::invalid_argument (the world unchanged) for a negative or non-finite
     /// penetration.
     void setMeshCcdSettings(const MeshCcdWorldSettings& settings);
     /// What the last internal step's mesh CCD did.
-    const MeshCcdCounters& lastMeshCcd() const { return counters_; }
-
-    /// A shape that is not a compound inside a body's shape, with its transform in the body's
-    /// frame (the body's shape itself when it is not a compound).
-    struct Leaf {
-        const btCollisionShape* shape;
-        btTransform local;
-    };
+    const MeshCcdCounters& lastMeshCcd() const;
 
   protected:
     void integrateTransforms(btScalar timeStep) override;
 
   private:
-    /// A leaf of a compound as a body of its own, for the algorithms' time of impact (a
-    /// btRigidBody: what they read of the real one, a rigid body or not, is copied).
-    struct ProxyObject : btRigidBody {
-        ProxyObject() : btRigidBody(btRigidBodyConstructionInfo(1, nullptr, nullptr)) {}
-        /// Becomes `leaf` of `object` (its flags, activation and CCD threshold), moving from
-        /// the object's world transform to `end`.
-        void take(const btCollisionObject& object, const Leaf& leaf, const btTransform& end);
-    };
-    /// One pair's time of impact; lowers the fractions its bodies may move (allowed_).
-    void timeOfImpact(btCollisionObject* a, btCollisionObject* b);
-    /// The same for a pair with a compound: every pair of their leaves with a MeshShape
-    /// whose boxes over the step meet, through an algorithm made for it (contacts at the
-    /// start first, then the time of impact).
-    void compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* b);
-    /// Both bodies may go `penetration` past `toi` (allowed_).
-    void limit(btCollisionObject* a, btCollisionObject* b, btScalar toi);
+    std::unique_ptr<detail::MeshCcdPass> pass_;
+};
 
-    MeshCcdWorldSettings settings_;
-    MeshCcdCounters counters_;
-    std::vector<btCollisionObject*> found_;
-    std::vector<std::pair<int, int>> pairs_;
-    struct Clamp {
-        btRigidBody* body;
-        btTransform transform;
-        btScalar hitFraction;
-        double fraction;       ///< of the step
-        btVector3 start, end;  ///< the origin at the start and the end of the whole step
-    };
-    std::vector<Clamp> clamped_;
-    std::map<const btCollisionObject*, double> allowed_;
-    btAlignedObjectArray<btRigidBody*> integrationOrder_;  ///< convex bodies first
-    btAlignedObjectArray<btRigidBody*> worldOrder_;
-    std::vector<Leaf> leavesA_, leavesB_;
-    ProxyObject proxyA_, proxyB_;
+/// The same pass in Bullet's multithreaded world (btDiscreteDynamicsWorldMt): everything as
+/// MeshCcdWorld's comment says, the pass itself single-threaded (before and after Bullet's
+/// parallel integrateTransforms, which integrates the bodies in parallel batches: the convex
+/// bodies first holds only when Bullet runs it on one thread, e.g. without BT_THREADSAFE or
+/// with the sequential task scheduler).
+class MeshCcdWorldMt : public btDiscreteDynamicsWorldMt {
+  public:
+    /// As btDiscreteDynamicsWorldMt's. Throws std::invalid_argument for bad `settings`.
+    MeshCcdWorldMt(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                   btConstraintSolverPoolMt* solverPool, btConstraintSolver* constraintSolverMt,
+                   btCollisionConfiguration* configuration,
+                   const MeshCcdWorldSettings& settings = {});
+    ~MeshCcdWorldMt() override;
+
+    const MeshCcdWorldSettings& meshCcdSettings() const;
+    /// As MeshCcdWorld's.
+    void setMeshCcdSettings(const MeshCcdWorldSettings& settings);
+    const MeshCcdCounters& lastMeshCcd() const;
+
+  protected:
+    void integrateTransforms(btScalar timeStep) override;
+
+  private:
+    std::unique_ptr<detail::MeshCcdPass> pass_;
 };
 
 }  // namespace kolize
