@@ -369,59 +369,36 @@ void MeshCcdPass::after(btDiscreteDynamicsWorld& world) {
     }
 }
 
-MeshCcdWorld::MeshCcdWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
-                           btConstraintSolver* solver, btCollisionConfiguration* configuration,
-                           const MeshCcdWorldSettings& settings)
-    : btDiscreteDynamicsWorld(dispatcher, broadphase, solver, configuration),
-      pass_(std::make_unique<detail::MeshCcdPass>(settings)) {}
+namespace detail {
 
-MeshCcdWorld::~MeshCcdWorld() = default;
-
-const MeshCcdWorldSettings& MeshCcdWorld::meshCcdSettings() const {
-    return pass_->settings();
+void MeshCcdPassDeleter::operator()(MeshCcdPass* pass) const {
+    delete pass;
 }
 
-void MeshCcdWorld::setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
-    pass_->setSettings(settings);
+MeshCcdPassPtr makeMeshCcdPass(const MeshCcdWorldSettings& settings) {
+    return MeshCcdPassPtr(new MeshCcdPass(settings));
 }
 
-const MeshCcdCounters& MeshCcdWorld::lastMeshCcd() const {
-    return pass_->counters();
+const MeshCcdWorldSettings& settingsOf(const MeshCcdPass& pass) {
+    return pass.settings();
 }
 
-void MeshCcdWorld::integrateTransforms(btScalar timeStep) {
-    pass_->before(*this, timeStep);
-    btDiscreteDynamicsWorld::integrateTransforms(timeStep);
-    pass_->after(*this);
+void setSettingsOf(MeshCcdPass& pass, const MeshCcdWorldSettings& settings) {
+    pass.setSettings(settings);
 }
 
-MeshCcdWorldMt::MeshCcdWorldMt(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
-                               btConstraintSolverPoolMt* solverPool,
-                               btConstraintSolver* constraintSolverMt,
-                               btCollisionConfiguration* configuration,
-                               const MeshCcdWorldSettings& settings)
-    : btDiscreteDynamicsWorldMt(dispatcher, broadphase, solverPool, constraintSolverMt,
-                                configuration),
-      pass_(std::make_unique<detail::MeshCcdPass>(settings)) {}
-
-MeshCcdWorldMt::~MeshCcdWorldMt() = default;
-
-const MeshCcdWorldSettings& MeshCcdWorldMt::meshCcdSettings() const {
-    return pass_->settings();
+const MeshCcdCounters& countersOf(const MeshCcdPass& pass) {
+    return pass.counters();
 }
 
-void MeshCcdWorldMt::setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
-    pass_->setSettings(settings);
+void beforeIntegration(MeshCcdPass& pass, btDiscreteDynamicsWorld& world, btScalar timeStep) {
+    pass.before(world, timeStep);
 }
 
-const MeshCcdCounters& MeshCcdWorldMt::lastMeshCcd() const {
-    return pass_->counters();
+void afterIntegration(MeshCcdPass& pass, btDiscreteDynamicsWorld& world) {
+    pass.after(world);
 }
 
-void MeshCcdWorldMt::integrateTransforms(btScalar timeStep) {
-    pass_->before(*this, timeStep);
-    btDiscreteDynamicsWorldMt::integrateTransforms(timeStep);
-    pass_->after(*this);
-}
+}  // namespace detail
 
 }  // namespace kolize

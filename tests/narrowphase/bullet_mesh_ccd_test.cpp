@@ -22,6 +22,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -155,6 +156,20 @@ bool intersectAt(const kolize::ccd::MovingMesh& a, const kolize::ccd::MovingMesh
     return kolize::narrowphase::meshCollide(*modelA, {}, *modelB, {}, settings).intersecting;
 }
 
+/// A flight along +x towards the wall at x = 0, drifting sideways within its face: the start
+/// and the end of the step (the end never behind the start).
+std::pair<btTransform, btTransform> flightTowardsTheWall(std::mt19937& random) {
+    std::uniform_real_distribution<double> startX(-1.5, -0.2), endX(-1.0, 1.5), side(-1.0, 1.0),
+        drift(-0.2, 0.2);
+    const double y = side(random), z = side(random);
+    const btTransform start = at(startX(random), y, z);
+    btTransform end = at(endX(random), y + drift(random), z + drift(random));
+    if (end.getOrigin().x() <= start.getOrigin().x()) {
+        end.getOrigin().setX(start.getOrigin().x() + btScalar(0.05));
+    }
+    return {start, end};
+}
+
 TEST(BulletMeshTimeOfImpact, TranslatingBoxMatchesTheAnalyticTime) {
     // A box translating along +x (drifting sideways, within the wall's face) against the
     // static 1 cm wall: first contact when its front face x0 + 0.1 + t (x1 - x0) reaches the
@@ -163,17 +178,10 @@ TEST(BulletMeshTimeOfImpact, TranslatingBoxMatchesTheAnalyticTime) {
     const TriangleMesh box = boxMesh(kBoxHalf);
     const TriangleMesh wall = boxMesh(kWallHalf);
     std::mt19937 random(20261202);
-    std::uniform_real_distribution<double> startX(-1.5, -0.2), endX(-1.0, 1.5), side(-1.0, 1.0),
-        drift(-0.2, 0.2);
     int hits = 0;
     const int cases = kolize::narrowphase::testing::scaled(400);
     for (int i = 0; i < cases; ++i) {
-        const double y = side(random), z = side(random);
-        const btTransform start = at(startX(random), y, z);
-        btTransform end = at(endX(random), y + drift(random), z + drift(random));
-        if (end.getOrigin().x() <= start.getOrigin().x()) {
-            end.getOrigin().setX(start.getOrigin().x() + btScalar(0.05));
-        }
+        const auto [start, end] = flightTowardsTheWall(random);
         Pair::move(*pair.a, start, end);
         Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));
         const btScalar toi = pair.timeOfImpact();
@@ -389,8 +397,6 @@ TEST(ConvexMeshTimeOfImpact, TranslatingBoxesMatchTheAnalyticTimeEitherBodyConve
     auto convexBox = std::make_shared<btBoxShape>(
         btVector3(btScalar(kBoxHalf.x()), btScalar(kBoxHalf.y()), btScalar(kBoxHalf.z())));
     std::mt19937 random(20261203);
-    std::uniform_real_distribution<double> startX(-1.5, -0.2), endX(-1.0, 1.5), side(-1.0, 1.0),
-        drift(-0.2, 0.2);
     const int cases = kolize::narrowphase::testing::scaled(100);
     for (bool convexMoves : {true, false}) {
         for (bool moverFirst : {true, false}) {
@@ -404,12 +410,7 @@ TEST(ConvexMeshTimeOfImpact, TranslatingBoxesMatchTheAnalyticTimeEitherBodyConve
             btRigidBody& still = moverFirst ? *pair.b : *pair.a;
             int hits = 0;
             for (int i = 0; i < cases; ++i) {
-                const double y = side(random), z = side(random);
-                const btTransform start = at(startX(random), y, z);
-                btTransform end = at(endX(random), y + drift(random), z + drift(random));
-                if (end.getOrigin().x() <= start.getOrigin().x()) {
-                    end.getOrigin().setX(start.getOrigin().x() + btScalar(0.05));
-                }
+                const auto [start, end] = flightTowardsTheWall(random);
                 Pair::move(body, start, end);
                 Pair::move(still, at(0, 0, 0), at(0, 0, 0));
                 const btScalar toi = pair.timeOfImpact();
@@ -772,6 +773,17 @@ TEST(BulletMeshCcdWorld, ThinWallStopsEveryBodyAtEverySpeed) {
     }
 }
 
+/// A MeshCcdWorld with kolize's algorithms registered (dbvt broadphase, Bullet's sequential
+/// impulse solver, Bullet's default gravity).
+struct CcdTestWorld {
+    CcdTestWorld() { kolize::registerNarrowphase(&dispatcher); }
+    btDefaultCollisionConfiguration configuration;
+    btCollisionDispatcher dispatcher{&configuration};
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    MeshCcdWorld world{&dispatcher, &broadphase, &solver, &configuration};
+};
+
 TEST(BulletMeshCcdWorld, RunsAreBitIdentical) {
     const ThrowResult first = throwAtWall(Method::kMeshCcdWorld, WallKind::kStaticMesh, 100);
     const ThrowResult second = throwAtWall(Method::kMeshCcdWorld, WallKind::kStaticMesh, 100);
@@ -781,12 +793,8 @@ TEST(BulletMeshCcdWorld, RunsAreBitIdentical) {
 }
 
 TEST(BulletMeshCcdWorld, TwoFastMeshBodiesStopEachOther) {
-    btDefaultCollisionConfiguration configuration;
-    btCollisionDispatcher dispatcher(&configuration);
-    kolize::registerNarrowphase(&dispatcher);
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    MeshCcdWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    CcdTestWorld parts;
+    MeshCcdWorld& world = parts.world;
     world.setGravity(btVector3(0, 0, 0));
     // Two 20 cm boxes flying at each other at 150 m/s each, slightly off-centre.
     auto plate = meshBox(kBoxHalf);
@@ -824,12 +832,8 @@ TEST(BulletMeshCcdWorld, TwoFastMeshBodiesStopEachOther) {
 /// swept sphere); 30 steps of 1/60 s, zero gravity. Whether the box ever ended a step past
 /// the other body's centre.
 bool passesThroughConvexBody(bool meshCcd, bool ball, double otherSpeed) {
-    btDefaultCollisionConfiguration configuration;
-    btCollisionDispatcher dispatcher(&configuration);
-    kolize::registerNarrowphase(&dispatcher);
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    MeshCcdWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    CcdTestWorld parts;
+    MeshCcdWorld& world = parts.world;
     world.setGravity(btVector3(0, 0, 0));
     std::unique_ptr<btCollisionShape> otherShape;
     if (ball) {
@@ -891,12 +895,8 @@ TEST(BulletMeshCcdWorld, MeshBodiesStopAtDynamicConvexBodies) {
 /// 1/60 s on a mesh floor from 10 m/s (gravity on, CCD threshold 5 cm: every step of the
 /// first half second is past it); its lowest height in `lowest`.
 double slideOnMeshFloor(bool compoundBody, bool ccd, double& lowest) {
-    btDefaultCollisionConfiguration configuration;
-    btCollisionDispatcher dispatcher(&configuration);
-    kolize::registerNarrowphase(&dispatcher);
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    MeshCcdWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    CcdTestWorld parts;
+    MeshCcdWorld& world = parts.world;
     auto floorShape = meshBox(Vec3(50, 0.05, 50));
     btRigidBody::btRigidBodyConstructionInfo floorInfo(0, nullptr, floorShape.get());
     floorInfo.m_startWorldTransform = at(0, -0.05, 0);
@@ -950,12 +950,8 @@ TEST(BulletMeshCcdWorld, PairsTheStepsBroadphaseDidNotSeeAreTested) {
     // first step, the solved velocity (167 m/s) takes the box 2.8 m down. The CCD pass asks
     // the broadphase itself and makes an algorithm for the pair.
     for (bool ccd : {true, false}) {
-        btDefaultCollisionConfiguration configuration;
-        btCollisionDispatcher dispatcher(&configuration);
-        kolize::registerNarrowphase(&dispatcher);
-        btDbvtBroadphase broadphase;
-        btSequentialImpulseConstraintSolver solver;
-        MeshCcdWorld world(&dispatcher, &broadphase, &solver, &configuration);
+        CcdTestWorld parts;
+        MeshCcdWorld& world = parts.world;
         world.setGravity(btVector3(0, 0, -1e4));
         auto floorShape = meshBox(Vec3(1.5, 1.5, 0.005));
         btRigidBody floor(btRigidBody::btRigidBodyConstructionInfo(0, nullptr, floorShape.get()));

@@ -54,6 +54,51 @@ struct MeshCcdCounters {
     std::size_t clamped = 0;  ///< bodies stopped at a time of impact
 };
 
+namespace detail {
+
+struct MeshCcdPassDeleter {
+    void operator()(MeshCcdPass* pass) const;
+};
+using MeshCcdPassPtr = std::unique_ptr<MeshCcdPass, MeshCcdPassDeleter>;
+MeshCcdPassPtr makeMeshCcdPass(const MeshCcdWorldSettings& settings);
+const MeshCcdWorldSettings& settingsOf(const MeshCcdPass& pass);
+void setSettingsOf(MeshCcdPass& pass, const MeshCcdWorldSettings& settings);
+const MeshCcdCounters& countersOf(const MeshCcdPass& pass);
+void beforeIntegration(MeshCcdPass& pass, btDiscreteDynamicsWorld& world, btScalar timeStep);
+void afterIntegration(MeshCcdPass& pass, btDiscreteDynamicsWorld& world);
+
+/// Bullet's `World` (btDiscreteDynamicsWorld or btDiscreteDynamicsWorldMt) with the mesh CCD
+/// pass around its integrateTransforms: MeshCcdWorld and MeshCcdWorldMt.
+template <class World>
+class WithMeshCcd : public World {
+  public:
+    /// Throws std::invalid_argument for bad `settings`.
+    template <class... WorldArguments>
+    explicit WithMeshCcd(const MeshCcdWorldSettings& settings, WorldArguments... arguments)
+        : World(arguments...), pass_(makeMeshCcdPass(settings)) {}
+
+    const MeshCcdWorldSettings& meshCcdSettings() const { return settingsOf(*pass_); }
+    /// Throws std::invalid_argument (the world unchanged) for a negative or non-finite
+    /// penetration.
+    void setMeshCcdSettings(const MeshCcdWorldSettings& settings) {
+        setSettingsOf(*pass_, settings);
+    }
+    /// What the last internal step's mesh CCD did.
+    const MeshCcdCounters& lastMeshCcd() const { return countersOf(*pass_); }
+
+  protected:
+    void integrateTransforms(btScalar timeStep) override {
+        beforeIntegration(*pass_, *this, timeStep);
+        World::integrateTransforms(timeStep);
+        afterIntegration(*pass_, *this);
+    }
+
+  private:
+    MeshCcdPassPtr pass_;
+};
+
+}  // namespace detail
+
 /// A btDiscreteDynamicsWorld with continuous collision for MeshShape bodies.
 ///
 /// Each internal step, in integrateTransforms (after the solver, before the bodies move):
@@ -93,30 +138,17 @@ struct MeshCcdCounters {
 /// shapes that are not compounds) with a MeshShape on one side whose boxes over the step
 /// meet, each through an algorithm made for it that first makes its contacts at the start
 /// (so the in-contact rule holds as for a pair in the cache); the earliest time limits both
-/// bodies. Not covered: the multithreaded btDiscreteDynamicsWorldMt. Two fast mesh bodies are
+/// bodies. MeshCcdWorldMt below is the same in btDiscreteDynamicsWorldMt. Two fast mesh bodies are
 /// handled as a pair, each moving. Deterministic: the result does not depend on the broadphase's
 /// report order. Cost per fast body: one aabbTest and, per pair found, meshCcd over both whole
 /// meshes.
-class MeshCcdWorld : public btDiscreteDynamicsWorld {
+class MeshCcdWorld : public detail::WithMeshCcd<btDiscreteDynamicsWorld> {
   public:
     /// As btDiscreteDynamicsWorld's. Throws std::invalid_argument for bad `settings`.
     MeshCcdWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
                  btConstraintSolver* solver, btCollisionConfiguration* configuration,
-                 const MeshCcdWorldSettings& settings = {});
-    ~MeshCcdWorld() override;
-
-    const MeshCcdWorldSettings& meshCcdSettings() const;
-    /// Throws std::invalid_argument (the world unchanged) for a negative or non-finite
-    /// penetration.
-    void setMeshCcdSettings(const MeshCcdWorldSettings& settings);
-    /// What the last internal step's mesh CCD did.
-    const MeshCcdCounters& lastMeshCcd() const;
-
-  protected:
-    void integrateTransforms(btScalar timeStep) override;
-
-  private:
-    std::unique_ptr<detail::MeshCcdPass> pass_;
+                 const MeshCcdWorldSettings& settings = {})
+        : WithMeshCcd(settings, dispatcher, broadphase, solver, configuration) {}
 };
 
 /// The same pass in Bullet's multithreaded world (btDiscreteDynamicsWorldMt): everything as
@@ -124,25 +156,15 @@ class MeshCcdWorld : public btDiscreteDynamicsWorld {
 /// parallel integrateTransforms, which integrates the bodies in parallel batches: the convex
 /// bodies first holds only when Bullet runs it on one thread, e.g. without BT_THREADSAFE or
 /// with the sequential task scheduler).
-class MeshCcdWorldMt : public btDiscreteDynamicsWorldMt {
+class MeshCcdWorldMt : public detail::WithMeshCcd<btDiscreteDynamicsWorldMt> {
   public:
     /// As btDiscreteDynamicsWorldMt's. Throws std::invalid_argument for bad `settings`.
     MeshCcdWorldMt(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
                    btConstraintSolverPoolMt* solverPool, btConstraintSolver* constraintSolverMt,
                    btCollisionConfiguration* configuration,
-                   const MeshCcdWorldSettings& settings = {});
-    ~MeshCcdWorldMt() override;
-
-    const MeshCcdWorldSettings& meshCcdSettings() const;
-    /// As MeshCcdWorld's.
-    void setMeshCcdSettings(const MeshCcdWorldSettings& settings);
-    const MeshCcdCounters& lastMeshCcd() const;
-
-  protected:
-    void integrateTransforms(btScalar timeStep) override;
-
-  private:
-    std::unique_ptr<detail::MeshCcdPass> pass_;
+                   const MeshCcdWorldSettings& settings = {})
+        : WithMeshCcd(settings, dispatcher, broadphase, solverPool, constraintSolverMt,
+                      configuration) {}
 };
 
 }  // namespace kolize
