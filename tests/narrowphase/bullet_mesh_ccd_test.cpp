@@ -529,6 +529,48 @@ TEST(ConvexMeshTimeOfImpact, PairsInContactAreLeftToTheContactsUnlessDrivenIn) {
     }
 }
 
+TEST(ConvexMeshTimeOfImpact, BadMotionAndBadShapesNeverCrash) {
+    const btScalar nan = std::numeric_limits<btScalar>::quiet_NaN();
+    const btScalar inf = std::numeric_limits<btScalar>::infinity();
+    auto broken = std::make_shared<btSphereShape>(btScalar(0.3));
+    broken->setUnscaledRadius(nan);
+    const std::vector<std::pair<std::string, std::shared_ptr<btCollisionShape>>> targets = {
+        {"box", std::make_shared<btBoxShape>(btVector3(btScalar(0.005), 1, 1))},
+        {"sphere", std::make_shared<btSphereShape>(btScalar(0.3))},
+        {"NaN sphere", broken},
+    };
+    for (const auto& [name, target] : targets) {
+        SCOPED_TRACE(name);
+        Pair pair(meshBox(kBoxHalf), 1, target, 0);
+        Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));
+        Pair::move(*pair.a, at(-1, 0, 0), at(-1, 0, 0));  // no motion
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+        Pair::move(*pair.a, at(-1, 0, 0), at(1e30, 0, 0));  // through it, huge
+        const btScalar huge = pair.timeOfImpact();
+        EXPECT_GE(huge, btScalar(0));
+        EXPECT_LE(huge, btScalar(1));
+        if (name != "NaN sphere") {
+            EXPECT_LT(huge, btScalar(1e-20));
+        } else {
+            EXPECT_EQ(huge, btScalar(1));  // no surface around a NaN shape: no time
+        }
+        Pair::move(*pair.a, at(-1, 0, 0), at(-1e30, 0, 0));  // away
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+        Pair::move(*pair.a, at(-1, 0, 0), at(double(nan), 0, 0));
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+        Pair::move(*pair.a, at(-1, 0, 0), at(double(inf), 0, 0));
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+        // The convex body moving instead, with a NaN basis.
+        btTransform bad = at(-1, 0, 0);
+        bad.getBasis()[0][0] = nan;
+        Pair::move(*pair.a, at(-1, 0, 0), at(-1, 0, 0));
+        pair.b->setMassProps(1, btVector3(1, 1, 1));
+        pair.b->setCcdMotionThreshold(btScalar(0.01));
+        Pair::move(*pair.b, at(0, 0, 0), bad);
+        EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // The wall in a world
 
