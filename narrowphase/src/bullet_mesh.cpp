@@ -960,17 +960,24 @@ namespace {
 /// MeshContactAlgorithm's comment says; `normals` are the normals (from A towards B) of the
 /// pair's contacts at the start of the step, empty when it did not touch. `hit` tells
 /// whether meshCcd found a contact.
+/// Whether the steps in `s` cannot give a time (a non-finite vertex) or the pair's contacts
+/// at the start hold it: in contact, the contacts hold the pair unless a vertex drives in
+/// along their normals by more than a CCD threshold (a body turning about its contact sweeps
+/// the rest of itself into, and through, the other; sliding or leaving does not). Places
+/// both steps whole.
+bool noTimeOrHeld(CcdBuffers& s, const std::vector<Vec3>& normals, btCollisionObject* body0,
+                  btCollisionObject* body1) {
+    if (!place(s.stepA, 0, 1, s.movingA) || !place(s.stepB, 0, 1, s.movingB)) {
+        return true;
+    }
+    return !normals.empty() &&
+           !drivesIn(normals, s.movingA, s.movingB, ccdThresholdOfPair(*body0, *body1));
+}
+
 btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals,
                                btCollisionObject* body0, btCollisionObject* body1, bool& hit) {
     hit = false;
-    if (!place(s.stepA, 0, 1, s.movingA) || !place(s.stepB, 0, 1, s.movingB)) {
-        return btScalar(1);
-    }
-    // In contact at the start: the contacts hold the pair unless a vertex drives in along
-    // their normals by more than a CCD threshold (a body turning about its contact sweeps
-    // the rest of itself into, and through, the other; sliding or leaving does not).
-    if (!normals.empty() &&
-        !drivesIn(normals, s.movingA, s.movingB, ccdThresholdOfPair(*body0, *body1))) {
+    if (noTimeOrHeld(s, normals, body0, body1)) {
         return btScalar(1);
     }
     const double turn = std::max(turnOf(s.stepA), turnOf(s.stepB));
@@ -1127,6 +1134,8 @@ ConvexMeshAlgorithm::ConvexMeshAlgorithm(const btCollisionAlgorithmConstructionI
 
 struct ConvexMeshAlgorithm::Ccd {
     const btCollisionShape* shape = nullptr;  ///< whose surface `polytope` is
+    btVector3 scaling, lo, hi;                ///< its scaling and local box then
+    btScalar margin = 0;                      ///< its margin then
     detail::EnclosingPolytope polytope;
     CcdBuffers buffers;
     std::vector<Vec3> normals;
@@ -1167,12 +1176,23 @@ btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
         ccd_ = std::make_unique<Ccd>();
     }
     Ccd& c = *ccd_;
-    if (c.shape != convexShape || !detail::encloses(c.polytope, convex)) {
+    btTransform identity;
+    identity.setIdentity();
+    btVector3 lo, hi;
+    convex.getAabb(identity, lo, hi);
+    // Rebuilt for another shape, or one that changed (scaled, margin, box), or no longer fits.
+    if (c.shape != convexShape || c.scaling != convex.getLocalScaling() ||
+        c.margin != convex.getMargin() || c.lo != lo || c.hi != hi ||
+        !detail::encloses(c.polytope, convex)) {
         c.shape = nullptr;
         if (!detail::enclosingPolytope(convex, c.polytope)) {
             return btScalar(1);
         }
         c.shape = convexShape;
+        c.scaling = convex.getLocalScaling();
+        c.margin = convex.getMargin();
+        c.lo = lo;
+        c.hi = hi;
     }
     const TriangleMesh& mesh =
         static_cast<const MeshShape*>(meshObject->getCollisionShape())->model().mesh();
@@ -1192,18 +1212,37 @@ btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
     }
     const btScalar fractionMesh = meshObject->getHitFraction();
     const btScalar fractionConvex = convexObject->getHitFraction();
-    bool hit = false;
-    btScalar toi = piecewiseTimeOfImpact(c.buffers, c.normals, meshObject, convexObject, hit);
-    if (!hit || !(c.polytope.standoff > 0)) {
-        return toi;
+    if (!(c.polytope.standoff > 0)) {
+        bool hit = false;  // the surface is the shape's own faces
+        return piecewiseTimeOfImpact(c.buffers, c.normals, meshObject, convexObject, hit);
     }
-    // The surface stands off a round shape: from its time on, advance to the shape itself.
+    // The surface stands off a round shape: advance to the shape itself, from the time
+    // against the surface, or from the start when the mesh may start inside the surface
+    // (nearer the shape than the standoff: the surface then has no entering event).
     const auto* meshShape = static_cast<const btConcaveShape*>(meshObject->getCollisionShape());
-    const double tolerance = 1e-3 * double(convex.getAngularMotionDisc());
-    const double advanced = detail::advanceToContact(
-        convex, {&convexObject->getWorldTransform(), &endOfStep(*convexObject)}, *meshShape,
-        {&meshObject->getWorldTransform(), &endOfStep(*meshObject)}, double(toi), tolerance);
-    toi = std::clamp(roundOutward(advanced, false), toi, btScalar(1));
+    // 5e-4 of the convex shape's angular motion disc: Bullet's float GJK errs by about 1e-4
+    // of a cone's or cylinder's size at small gaps (a tolerance of the mesh's size, smaller,
+    // made times against them up to 1.2 mm late).
+    const double tolerance = 5e-4 * double(convex.getAngularMotionDisc());
+    const btTransform& convexStart = convexObject->getWorldTransform();
+    const btTransform& meshStart = meshObject->getWorldTransform();
+    const double reach = c.polytope.standoff + tolerance;
+    btScalar from = 0;
+    if (detail::nearestDistance(convex, convexStart, *meshShape, meshStart, reach) <= reach) {
+        if (noTimeOrHeld(c.buffers, c.normals, meshObject, convexObject)) {
+            return btScalar(1);
+        }
+    } else {
+        bool hit = false;
+        from = piecewiseTimeOfImpact(c.buffers, c.normals, meshObject, convexObject, hit);
+        if (!hit) {
+            return from;
+        }
+    }
+    const double advanced =
+        detail::advanceToContact(convex, {&convexStart, &endOfStep(*convexObject)}, *meshShape,
+                                 {&meshStart, &endOfStep(*meshObject)}, double(from), tolerance);
+    const btScalar toi = std::clamp(roundOutward(advanced, false), from, btScalar(1));
     meshObject->setHitFraction(std::min(fractionMesh, toi));
     convexObject->setHitFraction(std::min(fractionConvex, toi));
     if (!movesOverStep(*meshObject)) {

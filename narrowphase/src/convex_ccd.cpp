@@ -220,6 +220,8 @@ bool encloses(const EnclosingPolytope& polytope, const btConvexShape& shape) {
 
 namespace {
 
+constexpr int kMaxAdvances = 256;
+
 btTransform poseAt(const Motion& motion, double t) {
     btTransform pose;
     pose.setOrigin(motion.start->getOrigin().lerp(motion.end->getOrigin(), btScalar(t)));
@@ -261,6 +263,17 @@ class NearestTriangle : public btTriangleCallback {
 
 }  // namespace
 
+double nearestDistance(const btConvexShape& convex, const btTransform& convexPose,
+                       const btConcaveShape& mesh, const btTransform& meshPose, double reach) {
+    btVector3 lo, hi;
+    convex.getAabb(meshPose.inverse() * convexPose, lo, hi);
+    const btScalar r = btScalar(reach);
+    const btVector3 pad(r, r, r);
+    NearestTriangle nearest(convex, convexPose, meshPose, 2 * reach);
+    mesh.processAllTriangles(&nearest, lo - pad, hi + pad);
+    return nearest.nearest;
+}
+
 double advanceToContact(const btConvexShape& convex, const Motion& convexMotion,
                         const btConcaveShape& mesh, const Motion& meshMotion, double from,
                         double tolerance) {
@@ -274,27 +287,23 @@ double advanceToContact(const btConvexShape& convex, const Motion& convexMotion,
         return from;
     }
     double t = std::max(0.0, from);
-    for (int advance = 0; advance < 64 && t < 1; ++advance) {
-        const btTransform convexPose = poseAt(convexMotion, t);
-        const btTransform meshPose = poseAt(meshMotion, t);
+    for (int advance = 0; advance < kMaxAdvances && t < 1; ++advance) {
         const double reach = bound * (1 - t) + tolerance;
-        btVector3 lo, hi;
-        convex.getAabb(meshPose.inverse() * convexPose, lo, hi);
-        const btScalar r = btScalar(reach);
-        const btVector3 pad(r, r, r);
-        NearestTriangle nearest(convex, convexPose, meshPose, 2 * reach);
-        mesh.processAllTriangles(&nearest, lo - pad, hi + pad);
-        if (nearest.nearest > reach) {
+        const double nearest =
+            nearestDistance(convex, poseAt(convexMotion, t), mesh, poseAt(meshMotion, t), reach);
+        if (nearest > reach) {
             return 1;  // nothing within reach for the rest of the step
         }
-        if (nearest.nearest <= tolerance) {
+        if (nearest <= tolerance) {
             return t;
         }
         if (!(bound > 0)) {
             return 1;
         }
-        // Half the tolerance kept in hand: GJK's distances are not exact.
-        t += (nearest.nearest - 0.5 * tolerance) / bound;
+        // A tenth of the distance and three quarters of the tolerance kept in hand: GJK's
+        // distances are not exact (in float, errors of 1e-4 of the shape's size were seen at
+        // small gaps, and of several percent of the gap for a cone's tip).
+        t += (0.9 * nearest - 0.75 * tolerance) / bound;
     }
     return t < 1 ? t : 1;
 }

@@ -31,7 +31,7 @@ struct EnclosingPolytope {
 /// plane is at or beyond the shape's support in its normal (which makes it contain the
 /// shape: a polytope contains a convex set when every face plane bounds the set's support
 /// in the face's normal). Exact for a box; around a sphere the faces are tangent and the
-/// vertices within 4% of the radius (3.5% measured). A flat or degenerate shape (a triangle, a
+/// vertices within 6% of the radius (5.8% measured). A flat or degenerate shape (a triangle, a
 /// segment) gets the box of its supporting vertices in the three axes instead. False when
 /// a supporting vertex is not finite (the output is then empty).
 bool enclosingPolytope(const btConvexShape& shape, EnclosingPolytope& out);
@@ -47,14 +47,22 @@ struct Motion {
     const btTransform* end;
 };
 
+/// The smallest GJK distance (margins included) between `convex` at `convexPose` and the
+/// triangles of `mesh` at `meshPose` within `reach` of the convex's box; more than `reach`
+/// when none is that near.
+double nearestDistance(const btConvexShape& convex, const btTransform& convexPose,
+                       const btConcaveShape& mesh, const btTransform& meshPose, double reach);
+
 /// The first contact of `convex` and `mesh` at or after `from` (a fraction of the step no
 /// later than it, e.g. the time against the surface around `convex`), by conservative
 /// advancement: at each time, the distance d between the shape and the mesh's triangles
 /// (Bullet's GJK, margins included) lets the step advance by d over a bound on how fast any
 /// point of one approaches the other (relative speed of the origins plus each turn times
 /// its angular motion disc). Stops within `tolerance` of contact; returns that time, or 1
-/// when the bodies do not meet before the end of the step (at most 64 advances; 1 too if
-/// GJK fails). Never later than the contact as far as GJK's distances are exact.
+/// when the bodies do not meet before the end of the step. At most 256 advances: a body
+/// gliding past within a few tolerances over a long motion can run out of them, and then
+/// gets the time reached (early, never late). Never later than the contact as far as GJK's
+/// distances are exact.
 double advanceToContact(const btConvexShape& convex, const Motion& convexMotion,
                         const btConcaveShape& mesh, const Motion& meshMotion, double from,
                         double tolerance);

@@ -986,6 +986,53 @@ TEST(BulletMeshCcdWorld, FastBodiesSlideOnTheirFloorAsWithoutCcd) {
     }
 }
 
+// Broke (found by review): a mesh tile falling at 30 m/s onto a thin round plate (a 2 cm
+// btCylinderShape of radius 5 m) was stopped 2.5 mm above it, inside the surface around the
+// plate (which stands off its rim), and went through in the next step: from inside, that
+// surface has no entering event. The advance now starts from the step's start then.
+TEST(BulletMeshCcdWorld, AMeshStoppedInsideTheSurfaceAroundARoundPlateDoesNotGoThrough) {
+    for (double radius : {1.0, 5.0}) {
+        CcdTestWorld parts;
+        MeshCcdWorld& world = parts.world;
+        world.setGravity(btVector3(0, 0, 0));
+        btCylinderShape plate(btVector3(btScalar(radius), btScalar(0.01), btScalar(radius)));
+        plate.setMargin(btScalar(0.002));
+        btRigidBody ground(btRigidBody::btRigidBodyConstructionInfo(0, nullptr, &plate));
+        world.addRigidBody(&ground);
+        auto tile = meshBox(Vec3(0.1, 0.005, 0.1));
+        btVector3 inertia;
+        tile->calculateLocalInertia(1, inertia);
+        btRigidBody body(btRigidBody::btRigidBodyConstructionInfo(1, nullptr, tile.get(), inertia));
+        body.setWorldTransform(at(0.3, 3, 0.2));
+        body.setLinearVelocity(btVector3(0, -30, 0));
+        body.setCcdMotionThreshold(btScalar(kThreshold));
+        body.setActivationState(DISABLE_DEACTIVATION);
+        world.addRigidBody(&body);
+        double lowest = 1e9;
+        for (int step = 0; step < 60; ++step) {
+            world.stepSimulation(btScalar(1.0 / 60), 0);
+            lowest = std::min(lowest, double(body.getWorldTransform().getOrigin().y()));
+        }
+        EXPECT_GT(lowest, 0.01) << "radius " << radius << ": the tile went into the plate";
+        world.removeRigidBody(&body);
+        world.removeRigidBody(&ground);
+    }
+}
+
+// Broke (found by review): a btBoxShape scaled down after its first time of impact kept the
+// surface of its larger self (which still contains it), so times came out early by the
+// difference (0.49 m here).
+TEST(ConvexMeshTimeOfImpactRegression, AShrunkShapeGetsANewSurface) {
+    auto wall = std::make_shared<btBoxShape>(btVector3(btScalar(0.5), 1, 1));
+    Pair pair(meshBox(kBoxHalf), 1, wall, 0);
+    Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));
+    Pair::move(*pair.a, at(-1.3, 0, 0), at(0.7, 0, 0));
+    EXPECT_NEAR(pair.timeOfImpact(), (1.3 - 0.6) / 2.0, 1e-5);
+    wall->setLocalScaling(btVector3(btScalar(0.02), 1, 1));  // half extent 0.01
+    Pair::move(*pair.a, at(-1.3, 0, 0), at(0.7, 0, 0));
+    EXPECT_NEAR(pair.timeOfImpact(), (1.3 - 0.11) / 2.0, 1e-5);
+}
+
 TEST(BulletMeshCcdWorld, PairsTheStepsBroadphaseDidNotSeeAreTested) {
     // A box at rest 0.5 m above a 1 cm floor under a gravity of 1e4 m/s^2: Bullet's
     // broadphase boxes (before the solver, which adds gravity) do not reach the floor in the

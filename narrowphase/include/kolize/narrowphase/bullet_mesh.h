@@ -256,16 +256,21 @@ class MeshMeshAlgorithm : public MeshContactAlgorithm {
 /// A convex shape against a MeshShape (either order): the tree gives the triangles in the
 /// convex's box, Bullet's convex-triangle algorithm the contacts. Never the SDF path.
 /// Time of impact (calculateTimeOfImpact): as for two meshes (MeshContactAlgorithm: the same
-/// step, pieces, rules and result), the mesh against a closed triangle surface that encloses
-/// the convex shape with its margin: exactly its faces for a box or another polytope
-/// (scaled out by its margin where the margin rounds it); for a round shape (a sphere,
-/// capsule, cylinder, cone) a polytope whose faces lie at or just beyond it and whose vertices
-/// stand off it by at most 4% of its radius; the box of its supports for a flat one (a
-/// triangle). Never later than the first contact with the shape itself,
-/// early by at most that enclosure. The surface is built on the first call (122 supporting
-/// vertices and their hull) and rebuilt when the shape changes so that it no longer
-/// encloses it. "Touching at the start" means the pair's manifold holds points. A fast
-/// convex body also gets Bullet's own CCD (its swept sphere in
+/// step, rules and result), the mesh against a closed triangle surface that contains the
+/// convex shape with its margin (built on the first call from 122 supporting vertices and
+/// their hull; rebuilt when the shape, its scaling, margin or box change, or it no longer
+/// fits). For a box or any other polytope without a rounding margin the surface is its own
+/// faces and the time is exact as for two meshes. Around a round shape (a sphere, capsule,
+/// cylinder, cone, a hull's rounded margin) the surface stands off the shape (a sphere's by
+/// 5.8% of its radius): the time against it is where conservative advancement (Bullet's GJK
+/// distances to the mesh's triangles) starts, or the start of the step when the mesh starts
+/// nearer the shape than that standoff, and the advance goes to within 5e-4 of the shape's
+/// angular motion disc of the shape itself; a body that only passes through the standoff
+/// gets 1. Never later than the first contact as far as GJK's distances are exact (for a
+/// turning body, the chords' as for two meshes). A body gliding past a round shape within a
+/// few tolerances over a long motion can run out of the advance's 256 steps and then gets
+/// the time reached (early). "Touching at the start" means the pair's manifold holds points.
+/// A fast convex body also gets Bullet's own CCD (its swept sphere in
 /// btDiscreteDynamicsWorld::integrateTransforms sweeps through MeshShape's
 /// processAllTriangles, the mesh held where it is).
 class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
