@@ -91,7 +91,19 @@ class CollectObjects : public btBroadphaseAabbCallback {
     std::vector<btCollisionObject*>& out_;
 };
 
-/// Whether the boxes of `leaf` over the step of `object` (start and end) overlap the other's.
+/// Whether `object` moves over the step: an active rigid body, neither static nor kinematic
+/// (the algorithms' rule for what has an end of the step of its own).
+bool movesOverStep(const btCollisionObject& object) {
+    return btRigidBody::upcast(&object) && object.isActive() && !object.isStaticOrKinematicObject();
+}
+
+/// Where `object` is at the end of the step: its interpolation transform if it moves.
+const btTransform& endOfStep(const btCollisionObject& object) {
+    return movesOverStep(object) ? object.getInterpolationWorldTransform()
+                                 : object.getWorldTransform();
+}
+
+/// The box (world frame) around `leaf` of `object` at the start and at the end of the step.
 void sweptLeafBox(const btCollisionObject& object, const btTransform& end, const Leaf& leaf,
                   btVector3& lo, btVector3& hi) {
     btVector3 endLo, endHi;
@@ -162,14 +174,8 @@ void MeshCcdPass::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* 
     leavesB_.clear();
     leavesOf(a->getCollisionShape(), identity, leavesA_);
     leavesOf(b->getCollisionShape(), identity, leavesB_);
-    auto ends = [](const btCollisionObject& object) -> const btTransform& {
-        const auto* body = btRigidBody::upcast(&object);
-        return body && body->isActive() && !body->isStaticOrKinematicObject()
-                   ? object.getInterpolationWorldTransform()
-                   : object.getWorldTransform();
-    };
-    const btTransform& endA = ends(*a);
-    const btTransform& endB = ends(*b);
+    const btTransform& endA = endOfStep(*a);
+    const btTransform& endB = endOfStep(*b);
     btScalar earliest = 1;
     for (const Leaf& leafA : leavesA_) {
         btVector3 loA, hiA;
@@ -213,8 +219,7 @@ void MeshCcdPass::compoundTimeOfImpact(btCollisionObject* a, btCollisionObject* 
     }
     if (earliest < 1) {
         for (btCollisionObject* object : {a, b}) {
-            if (object->getHitFraction() > earliest && btRigidBody::upcast(object) &&
-                object->isActive() && !object->isStaticOrKinematicObject()) {
+            if (object->getHitFraction() > earliest && movesOverStep(*object)) {
                 object->setHitFraction(earliest);
             }
         }
