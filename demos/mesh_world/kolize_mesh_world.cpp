@@ -5,7 +5,9 @@
 // time, contacts, the deepest contact, energy gained, escaped (tunnelled) bodies, NaN, and an
 // exact audit of the contacts every few frames (contact_audit.h): pairs whose manifold claims
 // a penetration the exact triangle test does not find (invented), and exactly intersecting
-// pairs without a contact (missing).
+// pairs without a contact (missing); and the meshes' penetration, measured exactly
+// (separationDepth: the shortest translation that parts the meshes), whatever the method
+// reports as its contacts' depths.
 
 #include "../common/cli.h"
 #include "../common/split.h"
@@ -45,6 +47,8 @@ const char* const kUsage =
     "  --substeps K        solver substeps per frame (default 1)\n"
     "  --ccd auto|on|off   CCD (kolize: its mesh CCD; default: on where the scene needs it)\n"
     "  --audit-every K     exact contact audit every K-th frame, 0 = never (default 5)\n"
+    "  --penetration on|off  the audit also measures each intersecting pair's penetration\n"
+    "                      (the shortest translation that parts the meshes; default on)\n"
     "  --broadphase NAME   the broadphase of every run (default sweep)\n"
     "  --seed S            scene seed (default 1)\n"
     "  --csv FILE          also write one line per scene and method\n";
@@ -63,6 +67,7 @@ struct Options {
     double contactMargin = 0.005;
     int frames = 180;
     int auditEvery = 5;
+    bool penetration = true;
     std::string broadphase = "sweep";
     std::string csv;
     kolize::SceneOptions scene;
@@ -111,6 +116,11 @@ Options parse(int argc, char** argv) {
                 fail("--ccd takes auto, on or off, got '" + value + "'");
             }
             options.scene.bulletCcd = value == "auto" ? -1 : value == "on" ? 1 : 0;
+        } else if (flag == "--penetration") {
+            if (value != "on" && value != "off") {
+                fail("--penetration takes on or off, got '" + value + "'");
+            }
+            options.penetration = value == "on";
         } else if (flag == "--audit-every") {
             options.auditEvery = int(kolize::demo::wholeNumber(flag, value, 0, 1000000, fail));
         } else if (flag == "--broadphase") {
@@ -159,8 +169,8 @@ int contactPoints(kolize::WorldScene& world) {
     return points;
 }
 
-void stepOnce(Run& run, bool audit) {
-    run.world->setContactAudit(audit);
+void stepOnce(Run& run, bool audit, const kolize::AuditSettings& settings) {
+    run.world->setContactAudit(audit, settings);
     const auto start = std::chrono::steady_clock::now();
     run.scene->step();
     run.stepMs.push_back(
@@ -195,7 +205,8 @@ int main(int argc, char** argv) {
                      "intersecting,invented,missing,max_false_depth_m,rounding_ties,"
                      "mesh_queries,convex_mesh_queries,sphere_tests,sphere_rejects,"
                      "sphere_skipped,tree_queries,no_tree,node_tests,triangle_tests,"
-                     "intersecting_triangles,toi_calls,toi_skipped_slow,toi_hits\n");
+                     "intersecting_triangles,toi_calls,toi_skipped_slow,toi_hits,"
+                     "max_penetration_m,mean_penetration_m\n");
     }
     std::printf(
         "kolize-mesh-world: Bullet %d, %s precision, broadphase %s, seed %u, %d frames of %.5g s "
@@ -235,26 +246,34 @@ int main(int argc, char** argv) {
             run.initialEnergy = state.kineticEnergy + state.potentialEnergy;
             runs.push_back(std::move(run));
         }
+        kolize::AuditSettings auditSettings;
+        auditSettings.penetration = options.penetration;
         for (int frame = 0; frame < options.frames; ++frame) {
             const bool audit = options.auditEvery > 0 && frame % options.auditEvery == 0;
             for (std::size_t k = 0; k < runs.size(); ++k) {
-                stepOnce(runs[(k + std::size_t(frame)) % runs.size()], audit);
+                stepOnce(runs[(k + std::size_t(frame)) % runs.size()], audit, auditSettings);
             }
         }
-        std::printf("%-13s %8s %9s %9s %9s %8s %9s %10s %7s %4s %7s %6s %8s %7s %10s\n", "method",
-                    "step ms", "narrow ms", "narr mean", "integr ms", "contacts", "deepest",
-                    "energy+ J", "escaped", "NaN", "audited", "inters", "invented", "missing",
-                    "false dep");
+        std::printf("%-13s %8s %9s %9s %9s %8s %9s %10s %7s %4s %7s %6s %8s %7s %10s %9s %9s\n",
+                    "method", "step ms", "narrow ms", "narr mean", "integr ms", "contacts",
+                    "deepest", "energy+ J", "escaped", "NaN", "audited", "inters", "invented",
+                    "missing", "false dep", "pen max", "pen mean");
         for (Run& run : runs) {
             const double step = kolize::median(run.stepMs), narrow = kolize::median(run.narrowMs),
                          narrowMean = mean(run.narrowMs),
                          integrate = kolize::median(run.integrateMs),
                          contacts = kolize::median(run.contacts);
+            const double penetrationMean =
+                run.audit.penetrationPairs > 0
+                    ? run.audit.sumPenetration / run.audit.penetrationPairs
+                    : 0;
             std::printf(
-                "%-13s %8.3f %9.3f %9.3f %9.3f %8.0f %9.2e %10.3g %7d %4d %7d %6d %8d %7d %10.2e\n",
+                "%-13s %8.3f %9.3f %9.3f %9.3f %8.0f %9.2e %10.3g %7d %4d %7d %6d %8d %7d %10.2e "
+                "%9.2e %9.2e\n",
                 run.method.c_str(), step, narrow, narrowMean, integrate, contacts, run.deepest,
                 run.energyGain, run.escaped, run.nonFinite, run.audit.pairs, run.audit.intersecting,
-                run.audit.invented, run.audit.missing, run.audit.maxFalseDepth);
+                run.audit.invented, run.audit.missing, run.audit.maxFalseDepth,
+                run.audit.maxPenetration, penetrationMean);
             if (csv != nullptr) {
                 std::fprintf(
                     csv,
@@ -274,7 +293,8 @@ int main(int argc, char** argv) {
                     return static_cast<unsigned long long>(value);
                 };
                 std::fprintf(
-                    csv, "%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu\n",
+                    csv,
+                    "%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%.6g,%.6g\n",
                     count(stages.mesh_mesh_queries + stages.mesh_scenery_queries),
                     count(stages.convex_mesh_queries), count(stages.object_sphere_tests),
                     count(stages.object_sphere_rejects),
@@ -282,8 +302,8 @@ int main(int argc, char** argv) {
                     count(stages.tree_queries), count(stages.no_tree_tiny + stages.no_tree_off),
                     count(stages.node_sphere_tests + stages.node_box_tests),
                     count(stages.triangle_tests), count(stages.intersecting_pairs),
-                    count(stages.toi_calls), count(stages.toi_skipped_slow),
-                    count(stages.toi_hits));
+                    count(stages.toi_calls), count(stages.toi_skipped_slow), count(stages.toi_hits),
+                    run.audit.maxPenetration, penetrationMean);
             }
         }
         const auto kolizeRun = std::find_if(runs.begin(), runs.end(),

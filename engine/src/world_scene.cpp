@@ -162,12 +162,13 @@ void WorldScene::setExactMesh(const btCollisionObject* body,
     exactMeshes_[body] = std::move(model);
 }
 
-void WorldScene::setContactAudit(bool on) {
+void WorldScene::setContactAudit(bool on, const AuditSettings& settings) {
     if (!on) {
         world_->setAfterNarrowphase(nullptr);
         return;
     }
-    world_->setAfterNarrowphase([this] { audit_ += auditContacts(*world_, exactMeshes_); });
+    world_->setAfterNarrowphase(
+        [this, settings] { audit_ += auditContacts(*world_, exactMeshes_, settings); });
 }
 
 void WorldScene::setRays(std::function<std::vector<WorldRay>(int frame)> rays) {

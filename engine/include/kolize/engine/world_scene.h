@@ -137,8 +137,8 @@ class WorldScene : public Scene {
                       std::shared_ptr<const narrowphase::MeshModel> model);
     /// With audits on, every internal step checks each overlapping pair of two bodies with
     /// exact meshes right after its narrowphase (contact_audit.h); lastAudit() sums the last
-    /// frame's steps.
-    void setContactAudit(bool on);
+    /// frame's steps; `settings` says what else it measures (the meshes' penetration).
+    void setContactAudit(bool on, const AuditSettings& settings = {});
     const ContactAudit& lastAudit() const { return audit_; }
 
   private:
