@@ -5,6 +5,8 @@
 // so it must lie between that depth and the depth over the cosine of the directions' covering
 // angle (27.6 degrees), plus the bisection's resolution; a box inside the other included.
 
+#include "box_mesh.h"
+
 #include <kolize/engine/contact_audit.h>
 #include <kolize/narrowphase/mesh_model.h>
 #include <kolize/narrowphase/triangle_mesh.h>
@@ -24,23 +26,14 @@
 namespace {
 
 using kolize::separationDepth;
-using kolize::narrowphase::Index3;
 using kolize::narrowphase::MeshModel;
 using kolize::narrowphase::Pose;
 using kolize::narrowphase::TriangleMesh;
 using kolize::narrowphase::Vec3;
 
 std::shared_ptr<const MeshModel> boxModel(const Vec3& h) {
-    std::vector<Vec3> vertices;
-    for (int i = 0; i < 8; ++i) {
-        vertices.emplace_back(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(),
-                              i & 4 ? h.z() : -h.z());
-    }
-    std::vector<Index3> triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
-                                     {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
-                                     {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
     return std::make_shared<const MeshModel>(
-        std::make_shared<const TriangleMesh>("box", vertices, triangles));
+        std::make_shared<const TriangleMesh>(kolize::testing::boxMesh(h)));
 }
 
 /// The penetration depth of two oriented boxes by the separating-axis theorem: the least

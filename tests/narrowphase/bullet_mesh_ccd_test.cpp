@@ -2,6 +2,7 @@
 // (bullet_mesh.h) against the analytic time of a translating box and against a brute-force
 // sampling of the moving meshes, and MeshCcdWorld (bullet_mesh_world.h) throwing boxes at a
 // 1 cm wall at 1-200 m/s, against Bullet's own worlds that let them through.
+#include "../box_mesh.h"
 #include "kolize/narrowphase/bullet_mesh_world.h"
 #include "kolize/narrowphase/mesh_ccd.h"
 #include "kolize/narrowphase/mesh_query.h"
@@ -33,18 +34,7 @@ using kolize::narrowphase::Index3;
 using kolize::narrowphase::TriangleMesh;
 using kolize::narrowphase::Vec3;
 
-/// A box [-h, h] as 8 vertices and 12 outward-wound triangles.
-TriangleMesh boxMesh(const Vec3& h) {
-    std::vector<Vec3> vertices;
-    for (int i = 0; i < 8; ++i) {
-        vertices.emplace_back(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(),
-                              i & 4 ? h.z() : -h.z());
-    }
-    std::vector<Index3> triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
-                                     {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
-                                     {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-    return TriangleMesh("box", vertices, triangles);
-}
+using kolize::testing::boxMesh;
 
 btTransform at(double x, double y, double z, const btQuaternion& q = btQuaternion::getIdentity()) {
     btTransform t;

@@ -2,6 +2,7 @@
 // dispatch tables, exact contacts on a stack of box meshes and on a triangulated floor, bad
 // input, determinism. References are independent of the adapter: Bullet's own box inertia,
 // brute-force triangle boxes, and the analytic contact geometry of axis-aligned stacks.
+#include "../box_mesh.h"
 #include "kolize/narrowphase/bullet_mesh.h"
 
 #include <btBulletCollisionCommon.h>
@@ -24,18 +25,7 @@ using kolize::narrowphase::MeshError;
 using kolize::narrowphase::TriangleMesh;
 using kolize::narrowphase::Vec3;
 
-/// A box [-h, h] as 8 vertices and 12 outward-wound triangles.
-TriangleMesh boxMesh(const Vec3& h, const std::string& name = "box") {
-    std::vector<Vec3> vertices;
-    for (int i = 0; i < 8; ++i) {
-        vertices.emplace_back(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(),
-                              i & 4 ? h.z() : -h.z());
-    }
-    std::vector<Index3> triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
-                                     {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
-                                     {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-    return TriangleMesh(name, vertices, triangles);
-}
+using kolize::testing::boxMesh;
 
 std::shared_ptr<MeshShape> boxShape(const Vec3& h) {
     return std::make_shared<MeshShape>(kolize::makeMeshModel(boxMesh(h)));
