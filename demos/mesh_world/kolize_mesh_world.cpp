@@ -47,7 +47,7 @@ const char* const kUsage =
     "  --substeps K        solver substeps per frame (default 1)\n"
     "  --ccd auto|on|off   CCD (kolize: its mesh CCD; default: on where the scene needs it)\n"
     "  --audit-every K     exact contact audit every K-th frame, 0 = never (default 5)\n"
-    "  --penetration on|off  the audit also measures each intersecting pair's penetration\n"
+    "  --penetration on|off  the audit also measures each audited pair's penetration\n"
     "                      (the shortest translation that parts the meshes; default on)\n"
     "  --broadphase NAME   the broadphase of every run (default sweep)\n"
     "  --seed S            scene seed (default 1)\n"

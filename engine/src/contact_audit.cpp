@@ -135,16 +135,22 @@ double separationDepthOf(const narrowphase::MeshModel& a, const narrowphase::Pos
     // Moved this far in any direction, B's vertices are all beyond A's reach.
     const narrowphase::Vec3 apart = poseB.translation - poseA.translation;
     const double bound = 1.01 * (reach(a) + reach(b) + apart.norm()) + 1e-12;
-    std::vector<narrowphase::Vec3> directions;
-    for (int x = -1; x <= 1; ++x) {
-        for (int y = -1; y <= 1; ++y) {
-            for (int z = -1; z <= 1; ++z) {
-                if (x != 0 || y != 0 || z != 0) {
-                    directions.push_back(narrowphase::Vec3(x, y, z).normalized());
+    // The 26 directions of a cube's faces, edges and corners, once; then the line between
+    // the bodies.
+    static const std::vector<narrowphase::Vec3> cube = [] {
+        std::vector<narrowphase::Vec3> out;
+        for (int x = -1; x <= 1; ++x) {
+            for (int y = -1; y <= 1; ++y) {
+                for (int z = -1; z <= 1; ++z) {
+                    if (x != 0 || y != 0 || z != 0) {
+                        out.push_back(narrowphase::Vec3(x, y, z).normalized());
+                    }
                 }
             }
         }
-    }
+        return out;
+    }();
+    std::vector<narrowphase::Vec3> directions = cube;
     if (apart.norm() > 0) {
         directions.push_back(apart.normalized());
     }
