@@ -242,6 +242,17 @@ int orient3dExact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
         }
         return 0;
     }
+    // Four points sharing one coordinate lie in a plane normal to that axis: zero, also
+    // without exact arithmetic (the touching faces of axis-aligned boxes, a mesh moved
+    // along or turned about one of its axes).
+    for (int k = 0; k < 3; ++k) {
+        if (a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) {
+            if (stats != nullptr) {
+                ++stats->orient3d[0];
+            }
+            return 0;
+        }
+    }
     if (const std::optional<int> s = orient3dExpansion(a, b, c, d)) {
         if (stats != nullptr) {
             ++stats->orient3d[1];

@@ -111,6 +111,34 @@ TEST(Predicates, Orient3dMatchesRationalsOnDegenerateFamilies) {
     EXPECT_EQ(stats.orient3d[0] + stats.orient3d[1] + stats.orient3d[2], std::uint64_t(cases));
 }
 
+TEST(Predicates, PointsSharingACoordinateAreDecidedWithoutExactArithmetic) {
+    // The faces of axis-aligned boxes, a mesh turned about one of its axes: four points with
+    // one coordinate equal are coplanar whatever the others (here random doubles, whose
+    // differences are not exact). One ulp off that plane, the sign must still be exact.
+    const unsigned seed = 1305;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-3, 3);
+    int nonzero = 0;
+    for (int i = 0; i < scaled(2000); ++i) {
+        const int axis = int(rng() % 3);
+        const double level = u(rng);
+        std::array<Vec3, 4> p;
+        for (Vec3& x : p) {
+            x = Vec3(u(rng), u(rng), u(rng));
+            x[axis] = level;
+        }
+        PredicateStats one;
+        EXPECT_EQ(orient3d(p[0], p[1], p[2], p[3], &one), 0) << "seed " << seed << " case " << i;
+        EXPECT_EQ(one.fallbacks(), 0u) << "seed " << seed << " case " << i;
+        p[i % 4][axis] = std::nextafter(level, i % 2 ? 1e300 : -1e300);
+        const int expected = rationalOrient3d(p[0], p[1], p[2], p[3]);
+        EXPECT_EQ(orient3d(p[0], p[1], p[2], p[3]), expected)
+            << "seed " << seed << " case " << i << " nudged";
+        nonzero += expected != 0;
+    }
+    EXPECT_GT(nonzero, scaled(2000) * 9 / 10);  // the nudged points are off the plane
+}
+
 TEST(Predicates, Orient2dMatchesRationalsOnDegenerateFamilies) {
     const unsigned seed = 1302;
     PointSource source(seed);
