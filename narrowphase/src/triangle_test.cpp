@@ -39,8 +39,9 @@ class Tester {
     int orient2(const Projection& pr, const Vec3& a, const Vec3& b, const Vec3& c) const {
         return orient2d(a[pr.u], a[pr.v], b[pr.u], b[pr.v], c[pr.u], c[pr.v], stats_);
     }
+    /// orient3d, its filter inlined here (the edge tests call it up to 9 times a pair).
     int orient3(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) const {
-        return orient3d(a, b, c, d, stats_);
+        return PlaneSide(a, b, c).side(d, stats_);
     }
 
     /// A projection in which t keeps a nonzero area, or none when t is degenerate.
@@ -202,6 +203,96 @@ bool sameStrictSide(const int s[3]) {
     return (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0);
 }
 
+/// The general case of decide (Guigue and Devillers, "Fast and robust triangle-triangle
+/// overlap test using orientation predicates", 2003): proper triangles in distinct planes,
+/// neither strictly on one side of the other's plane. Each triangle meets the planes' common
+/// line in an interval; with each triangle's vertices named so that the first is alone on its
+/// side of the other's plane (and the other triangle's last two swapped when that side is the
+/// negative one, which reverses its normal), the intervals overlap iff two orientations are
+/// not positive. Exact with exact orientations, touching included; 2 orient3d besides the 6
+/// plane sides, where testing each edge against the other triangle takes 3 to 9.
+///
+/// Overlap of the canonical pair: a0 alone on its side of b's plane, b0 alone on its side of
+/// a's plane, both on the positive side once the swaps are made.
+bool intervalsMeet(const Tester& t, const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                   const Vec3& b1, const Vec3& b2) {
+    return t.orient3(a1, b0, a0, b1) <= 0 && t.orient3(a0, b0, a2, b2) <= 0;
+}
+
+/// a in canonical order; b named so that s0, s1, s2 are its sides relative to a's plane:
+/// renames b so that b0 is alone on its side (and a's last two swapped for the negative side).
+bool canonicalB(const Tester& t, const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                const Vec3& b1, const Vec3& b2, int s0, int s1, int s2) {
+    if (s0 > 0) {
+        if (s1 > 0) {
+            return intervalsMeet(t, a0, a2, a1, b2, b0, b1);
+        }
+        if (s2 > 0) {
+            return intervalsMeet(t, a0, a2, a1, b1, b2, b0);
+        }
+        return intervalsMeet(t, a0, a1, a2, b0, b1, b2);
+    }
+    if (s0 < 0) {
+        if (s1 < 0) {
+            return intervalsMeet(t, a0, a1, a2, b2, b0, b1);
+        }
+        if (s2 < 0) {
+            return intervalsMeet(t, a0, a1, a2, b1, b2, b0);
+        }
+        return intervalsMeet(t, a0, a2, a1, b0, b1, b2);
+    }
+    if (s1 < 0) {
+        return s2 >= 0 ? intervalsMeet(t, a0, a2, a1, b1, b2, b0)
+                       : intervalsMeet(t, a0, a1, a2, b0, b1, b2);
+    }
+    if (s1 > 0) {
+        return s2 > 0 ? intervalsMeet(t, a0, a2, a1, b0, b1, b2)
+                      : intervalsMeet(t, a0, a1, a2, b1, b2, b0);
+    }
+    // s1 == 0 (s2 != 0: b is not in a's plane)
+    return s2 > 0 ? intervalsMeet(t, a0, a1, a2, b2, b0, b1)
+                  : intervalsMeet(t, a0, a2, a1, b2, b0, b1);
+}
+
+/// sp: p's vertices relative to q's plane, sq: q's relative to p's (not all zero, not all of
+/// one strict sign, either of them).
+bool generalHit(const Tester& t, const Triangle& p, const Triangle& q, const int sp[3],
+                const int sq[3]) {
+    const Vec3 &p0 = p[0], &p1 = p[1], &p2 = p[2];
+    const Vec3 &q0 = q[0], &q1 = q[1], &q2 = q[2];
+    const int r0 = sp[0], r1 = sp[1], r2 = sp[2];
+    const int s0 = sq[0], s1 = sq[1], s2 = sq[2];
+    if (r0 > 0) {
+        if (r1 > 0) {
+            return canonicalB(t, p2, p0, p1, q0, q2, q1, s0, s2, s1);
+        }
+        if (r2 > 0) {
+            return canonicalB(t, p1, p2, p0, q0, q2, q1, s0, s2, s1);
+        }
+        return canonicalB(t, p0, p1, p2, q0, q1, q2, s0, s1, s2);
+    }
+    if (r0 < 0) {
+        if (r1 < 0) {
+            return canonicalB(t, p2, p0, p1, q0, q1, q2, s0, s1, s2);
+        }
+        if (r2 < 0) {
+            return canonicalB(t, p1, p2, p0, q0, q1, q2, s0, s1, s2);
+        }
+        return canonicalB(t, p0, p1, p2, q0, q2, q1, s0, s2, s1);
+    }
+    if (r1 < 0) {
+        return r2 >= 0 ? canonicalB(t, p1, p2, p0, q0, q2, q1, s0, s2, s1)
+                       : canonicalB(t, p0, p1, p2, q0, q1, q2, s0, s1, s2);
+    }
+    if (r1 > 0) {
+        return r2 > 0 ? canonicalB(t, p0, p1, p2, q0, q2, q1, s0, s2, s1)
+                      : canonicalB(t, p1, p2, p0, q0, q1, q2, s0, s1, s2);
+    }
+    // r1 == 0 (r2 != 0: p is not in q's plane)
+    return r2 > 0 ? canonicalB(t, p2, p0, p1, q0, q1, q2, s0, s1, s2)
+                  : canonicalB(t, p2, p0, p1, q0, q2, q1, s0, s2, s1);
+}
+
 /// Which case decided the test, and what the geometry needs from it.
 struct Decision {
     enum class Case { kSeparate, kGeneral, kCoplanar, kDegenerateP, kDegenerateQ, kBothDegenerate };
@@ -272,64 +363,9 @@ Decision decide(const Triangle& p, const Triangle& q, PredicateStats* stats) {
         }
         return d;
     }
-    // Both proper, planes distinct. o[i][j] = orient3d(p_i, p_i+1, q_j, q_j+1), computed on
-    // demand; orient3d(q_j, q_j+1, p_i, p_i+1) is the same number (an even permutation).
+    // Both proper, planes distinct, each meeting the other's plane.
     d.kind = Decision::Case::kGeneral;
-    int o[3][3];
-    bool known[3][3] = {};
-    auto edgeEdge = [&](int i, int j) {
-        if (!known[i][j]) {
-            o[i][j] = t.orient3(p[i], p[(i + 1) % 3], q[j], q[(j + 1) % 3]);
-            known[i][j] = true;
-        }
-        return o[i][j];
-    };
-    auto lineHits = [](int o0, int o1, int o2) {
-        return (o0 >= 0 && o1 >= 0 && o2 >= 0) || (o0 <= 0 && o1 <= 0 && o2 <= 0);
-    };
-    std::optional<Projection> prP, prQ;
-    for (int i = 0; i < 3; ++i) {
-        const int i1 = (i + 1) % 3;
-        if (d.sp[i] * d.sp[i1] > 0) {
-            continue;
-        }
-        if (d.sp[i] == 0 && d.sp[i1] == 0) {
-            if (!prQ) {
-                prQ = t.areaKeeping(q, d.nq);
-            }
-            if (t.segmentTriangle2d(*prQ, p[i], p[i1], q)) {
-                d.hit = true;
-                return d;
-            }
-            continue;
-        }
-        const int o0 = edgeEdge(i, 0), o1 = edgeEdge(i, 1);
-        if (o0 * o1 >= 0 && lineHits(o0, o1, edgeEdge(i, 2))) {
-            d.hit = true;
-            return d;
-        }
-    }
-    for (int j = 0; j < 3; ++j) {
-        const int j1 = (j + 1) % 3;
-        if (d.sq[j] * d.sq[j1] > 0) {
-            continue;
-        }
-        if (d.sq[j] == 0 && d.sq[j1] == 0) {
-            if (!prP) {
-                prP = t.areaKeeping(p, d.np);
-            }
-            if (t.segmentTriangle2d(*prP, q[j], q[j1], p)) {
-                d.hit = true;
-                return d;
-            }
-            continue;
-        }
-        const int o0 = edgeEdge(0, j), o1 = edgeEdge(1, j);
-        if (o0 * o1 >= 0 && lineHits(o0, o1, edgeEdge(2, j))) {
-            d.hit = true;
-            return d;
-        }
-    }
+    d.hit = generalHit(t, p, q, d.sp, d.sq);
     return d;
 }
 
