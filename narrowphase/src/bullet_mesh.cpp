@@ -189,9 +189,10 @@ constexpr std::size_t kMaxNormalCandidates = 64;
 /// Scratch of contact building (reused by an algorithm across frames).
 struct ContactScratch {
     std::vector<int> parent;
-    std::vector<int> root;             // each pair's patch (its set's root)
-    std::vector<int> lastPair;         // unionByVertex's map, all -1 between calls
-    std::vector<unsigned char> marks;  // uniqueSorted's, all 0 between calls
+    std::vector<int> root;                  // each pair's patch (its set's root)
+    std::vector<int> lastPair;              // unionByVertex's map, all -1 between calls
+    std::vector<unsigned char> marks;       // uniqueSorted's, all 0 between calls
+    std::vector<int> normalOfA, normalOfB;  // a triangle's entry in `normals`, -1 between calls
     std::vector<int> order;
     std::vector<int> patchStart;
     std::vector<Patch> patches;
@@ -316,6 +317,12 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
         s.lastPair.resize(vertexCount, -1);
         s.marks.resize(vertexCount, 0);
     }
+    if (s.normalOfA.size() < meshA.triangleCount()) {
+        s.normalOfA.resize(meshA.triangleCount(), -1);
+    }
+    if (s.normalOfB.size() < meshB.triangleCount()) {
+        s.normalOfB.resize(meshB.triangleCount(), -1);
+    }
     unionByVertex(
         count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i]->pair.a][k]; },
         s.parent, s.lastPair);
@@ -365,16 +372,28 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
             const Vec3 normalB =
                 outward(c.normal_b, sidesB, meshB, ib, &bInA, bInA.apply(Vec3::Zero()));
             sum += weight * (normalA - normalB);
-            if (normalA.squaredNorm() > 0) {
-                s.normals.push_back({weight, normalA});
-            }
-            if (normalB.squaredNorm() > 0) {
-                s.normals.push_back({weight, -normalB});
-            }
+            // One entry per triangle, at its heaviest pair's weight (a triangle's normal is
+            // the same in every pair it is in).
+            auto add = [&](int& slot, const Vec3& n) {
+                if (slot >= 0) {
+                    s.normals[slot].first = std::max(s.normals[slot].first, weight);
+                } else if (n.squaredNorm() > 0) {
+                    slot = int(s.normals.size());
+                    s.normals.push_back({weight, n});
+                }
+            };
+            add(s.normalOfA[c.pair.a], normalA);
+            add(s.normalOfB[c.pair.b], -normalB);
+        }
+        for (std::size_t k = begin; k < end; ++k) {
+            const PairContact& c = *pairs[s.order[k]];
+            s.normalOfA[c.pair.a] = -1;
+            s.normalOfB[c.pair.b] = -1;
         }
         uniqueSorted(s.verticesA, s.marks);
         uniqueSorted(s.verticesB, s.marks);
-        // The heaviest distinct face normals (a deep patch of a fine mesh has thousands).
+        // The heaviest distinct face normals (a deep patch of a fine mesh has thousands):
+        // first by weight, so that of equal overlaps the heaviest normal wins.
         std::sort(s.normals.begin(), s.normals.end(), [](const auto& x, const auto& y) {
             if (x.first != y.first) {
                 return x.first > y.first;
@@ -479,14 +498,6 @@ void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
         double bestValue = step == 1 ? tinyLength : tinyLength * scale;
         for (int i = 0; i < int(s.candidates.size()); ++i) {
             const Vec3& p = s.candidates[i].point;
-            bool repeated = false;
-            for (int k = 0; k < chosenCount; ++k) {
-                repeated =
-                    repeated || (p - s.candidates[chosen[k]].point).squaredNorm() <= tinyLength;
-            }
-            if (repeated) {
-                continue;
-            }
             const Vec3& p0 = s.candidates[chosen[0]].point;
             double value = 0;
             if (step == 1) {
@@ -502,8 +513,17 @@ void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
                                   (p0 - p).cross(p1 - p2).squaredNorm()});
             }
             if (value > bestValue) {
-                bestValue = value;
-                best = i;
+                // A point already chosen (within tinyLength) is never chosen again. Only the
+                // points that would win are checked: the same choice as skipping repeats first.
+                bool repeated = false;
+                for (int k = 0; k < chosenCount; ++k) {
+                    repeated =
+                        repeated || (p - s.candidates[chosen[k]].point).squaredNorm() <= tinyLength;
+                }
+                if (!repeated) {
+                    bestValue = value;
+                    best = i;
+                }
             }
         }
         if (best < 0) {
