@@ -10,12 +10,12 @@
 #include <optional>
 
 // Why the decision is complete. Closed triangles P and Q (non-degenerate, not coplanar)
-// meet iff an edge of one meets the other: their intersection is a segment of the line
-// plane(P) n plane(Q) whose end points lie on edges of P or Q. A zero-area triangle is the
-// union of its three edges. Coplanar triangles are decided in a coordinate projection in
-// which one of them keeps a nonzero area; that projection is injective on the common plane,
-// so the 2D answer is the 3D answer. Everything is a sign of orient3d or orient2d of input
-// points, or a comparison of input coordinates: exact.
+// meet iff their chords on the line plane(P) n plane(Q) overlap; Guigue and Devillers' two
+// orientations decide that overlap once each triangle's vertices are named by their sides
+// of the other's plane (generalHit). A zero-area triangle is the union of its three edges. Coplanar
+// triangles are decided in a coordinate projection in which one of them keeps a nonzero area; that
+// projection is injective on the common plane, so the 2D answer is the 3D answer. Everything is a
+// sign of orient3d or orient2d of input points, or a comparison of input coordinates: exact.
 
 namespace kolize::narrowphase {
 
@@ -39,7 +39,7 @@ class Tester {
     int orient2(const Projection& pr, const Vec3& a, const Vec3& b, const Vec3& c) const {
         return orient2d(a[pr.u], a[pr.v], b[pr.u], b[pr.v], c[pr.u], c[pr.v], stats_);
     }
-    /// orient3d, its filter inlined here (the edge tests call it up to 9 times a pair).
+    /// orient3d, its filter inlined here.
     int orient3(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) const {
         return PlaneSide(a, b, c).side(d, stats_);
     }

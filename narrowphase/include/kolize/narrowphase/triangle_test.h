@@ -18,9 +18,10 @@ namespace kolize::narrowphase {
 using Triangle = std::array<Vec3, 3>;
 
 /// True when the closed triangles p and q share at least one point. Exact. Cost: 6 filtered
-/// orient3d for the planes' sides (which reject most separated pairs), then up to 9 orient3d
-/// for the edges; coplanar and degenerate pairs use orient2d in a projection that keeps
-/// them apart exactly. `stats` (optional) counts the predicate stages.
+/// orient3d for the planes' sides (which reject most separated pairs), then 2 orient3d for
+/// the overlap of the two chords on the planes' line (Guigue and Devillers); coplanar and
+/// degenerate pairs use orient2d in a projection that keeps them apart exactly. `stats` (optional)
+/// counts the predicate stages.
 bool trianglesIntersect(const Triangle& p, const Triangle& q, PredicateStats* stats = nullptr);
 
 /// Where two intersecting triangles meet, built in double after the exact decision (so the
