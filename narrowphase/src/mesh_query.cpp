@@ -35,6 +35,32 @@ class NodePair {
     std::uint64_t bits_ = 0;
 };
 
+Vec3 unitNormal(const Triangle& t) {
+    const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+    const double length = n.norm();
+    return length > 0 ? Vec3(n / length) : Vec3::Zero();
+}
+
+/// A triangle's unitNormal, computed on first use: a leaf's triangle meets several of the
+/// other leaf's, and a contact needs both normals.
+class LazyNormal {
+  public:
+    LazyNormal() = default;
+    explicit LazyNormal(const Triangle& t) : t_(&t) {}
+    const Vec3& get() {
+        if (!known_) {
+            normal_ = unitNormal(*t_);
+            known_ = true;
+        }
+        return normal_;
+    }
+
+  private:
+    const Triangle* t_ = nullptr;
+    Vec3 normal_ = Vec3::Zero();
+    bool known_ = false;
+};
+
 }  // namespace
 
 struct MeshQuery::Front {
@@ -60,6 +86,9 @@ struct QueryScratch::Impl {
     std::vector<NodePair> nextFront;
     std::vector<Triangle> directTriangles;  // B's triangles in A's frame (no-tree queries)
     std::vector<Vec3> directLo, directHi;
+    std::vector<LazyNormal> directNormals;  // their unit normals, computed on first use
+    std::vector<double> directBoxes;        // their boxes: lo x, y, z, hi x, y, z runs
+    std::vector<std::int32_t> directMet;    // the B triangles whose boxes meet A's
 
     std::uint32_t nextStamp() {
         if (++stamp == 0) {  // wrapped: forget every old stamp once every 2^32 queries
@@ -118,41 +147,10 @@ struct Context {
     }
 };
 
-Vec3 unitNormal(const Triangle& t) {
-    const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
-    const double length = n.norm();
-    return length > 0 ? Vec3(n / length) : Vec3::Zero();
-}
-
-/// A triangle's unitNormal, computed on first use: a leaf's triangle meets several of the
-/// other leaf's, and a contact needs both normals.
-class LazyNormal {
-  public:
-    explicit LazyNormal(const Triangle& t) : t_(&t) {}
-    const Vec3& get() {
-        if (!known_) {
-            normal_ = unitNormal(*t_);
-            known_ = true;
-        }
-        return normal_;
-    }
-
-  private:
-    const Triangle* t_;
-    Vec3 normal_;
-    bool known_ = false;
-};
-
-/// One triangle pair: exact boxes, facing filter, exact test; records a hit under the mesh
-/// triangle indices (ia, ib). Returns false when a yes/no query must stop.
-bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& phi,
-                  LazyNormal& normalP, const Triangle& q, const Vec3& qlo, const Vec3& qhi,
-                  LazyNormal& normalQ, std::int32_t ia, std::int32_t ib) {
-    const double m = c.margin;  // 0 without a contact margin: the exact boxes
-    if ((plo.array() - m > qhi.array()).any() || (qlo.array() - m > phi.array()).any()) {
-        ++c.counters.triangle_box_rejects;
-        return true;
-    }
+/// One triangle pair whose boxes overlap: facing filter, exact test; records a hit under the
+/// mesh triangle indices (ia, ib). Returns false when a yes/no query must stop.
+bool exactPair(Context& c, const Triangle& p, LazyNormal& normalP, const Triangle& q,
+               LazyNormal& normalQ, std::int32_t ia, std::int32_t ib) {
     if (c.settings.facing_filter) {
         const Vec3 na = (p[1] - p[0]).cross(p[2] - p[0]);
         const Vec3 nb = (q[1] - q[0]).cross(q[2] - q[0]);
@@ -190,6 +188,18 @@ bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& ph
         return false;
     }
     return true;
+}
+
+/// One triangle pair: exact boxes (widened by the contact margin), then exactPair.
+bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& phi,
+                  LazyNormal& normalP, const Triangle& q, const Vec3& qlo, const Vec3& qhi,
+                  LazyNormal& normalQ, std::int32_t ia, std::int32_t ib) {
+    const double m = c.margin;  // 0 without a contact margin: the exact boxes
+    if ((plo.array() - m > qhi.array()).any() || (qlo.array() - m > phi.array()).any()) {
+        ++c.counters.triangle_box_rejects;
+        return true;
+    }
+    return exactPair(c, p, normalP, q, normalQ, ia, ib);
 }
 
 /// Every triangle pair of a leaf pair.
@@ -236,9 +246,19 @@ void directPairs(Context& c) {
     std::vector<Triangle>& qs = c.scratch.directTriangles;
     std::vector<Vec3>& qlo = c.scratch.directLo;
     std::vector<Vec3>& qhi = c.scratch.directHi;
+    std::vector<LazyNormal>& nq = c.scratch.directNormals;
+    std::vector<double>& boxes = c.scratch.directBoxes;
+    std::vector<std::int32_t>& met = c.scratch.directMet;
     qs.resize(countB);
     qlo.resize(countB);
     qhi.resize(countB);
+    nq.resize(countB);
+    boxes.resize(6 * countB);
+    met.resize(countB);
+    // B's whole box in A's frame, widened by the margin: an A triangle outside it meets no
+    // B triangle's box (the per-pair test below would reject each pair in turn).
+    Vec3 allLo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 allHi = -allLo;
     for (std::size_t j = 0; j < countB; ++j) {
         const Index3& t = mb.triangles()[j];
         for (int k = 0; k < 3; ++k) {
@@ -246,18 +266,42 @@ void directPairs(Context& c) {
         }
         qlo[j] = qs[j][0].cwiseMin(qs[j][1]).cwiseMin(qs[j][2]);
         qhi[j] = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
+        allLo = allLo.cwiseMin(qlo[j]);
+        allHi = allHi.cwiseMax(qhi[j]);
+        nq[j] = LazyNormal(qs[j]);
+        for (int k = 0; k < 3; ++k) {
+            boxes[k * countB + j] = qlo[j][k];
+            boxes[(3 + k) * countB + j] = qhi[j][k];
+        }
     }
+    const double m = c.margin;
     const std::vector<Vec3>& va = ma.vertices();
     for (std::size_t i = 0; i < ma.triangleCount(); ++i) {
         const Index3& ti = ma.triangles()[i];
         const Triangle p = {va[ti[0]], va[ti[1]], va[ti[2]]};
         const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
         const Vec3 phi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
-        LazyNormal np(p);
+        if ((plo.array() - m > allHi.array()).any() || (allLo.array() - m > phi.array()).any()) {
+            c.counters.triangle_box_rejects += countB;
+            continue;
+        }
+        // The box test of every B triangle, coordinate by coordinate without a branch (the
+        // same comparisons as trianglePair's); then the exact test of those that met.
+        const double* lo[3] = {&boxes[0], &boxes[countB], &boxes[2 * countB]};
+        const double* hi[3] = {&boxes[3 * countB], &boxes[4 * countB], &boxes[5 * countB]};
+        std::size_t metCount = 0;
         for (std::size_t j = 0; j < countB; ++j) {
-            LazyNormal nq(qs[j]);
-            if (!trianglePair(c, p, plo, phi, np, qs[j], qlo[j], qhi[j], nq, std::int32_t(i),
-                              std::int32_t(j))) {
+            const bool apart = (plo.x() - m > hi[0][j]) | (plo.y() - m > hi[1][j]) |
+                               (plo.z() - m > hi[2][j]) | (lo[0][j] - m > phi.x()) |
+                               (lo[1][j] - m > phi.y()) | (lo[2][j] - m > phi.z());
+            met[metCount] = std::int32_t(j);
+            metCount += apart ? 0 : 1;
+        }
+        c.counters.triangle_box_rejects += countB - metCount;
+        LazyNormal np(p);
+        for (std::size_t k = 0; k < metCount; ++k) {
+            const std::int32_t j = met[k];
+            if (!exactPair(c, p, np, qs[j], nq[j], std::int32_t(i), j)) {
                 return;
             }
         }
@@ -672,6 +716,18 @@ const QueryResult& MeshQuery::run(const MeshModel& a, const Pose& poseA, const M
     }
     if (!settings.use_tree) {
         resetFront();  // a later tree query must start from the roots
+        // The root volumes first (OBB trees: one separating-axis test, as the traversal's
+        // first step): a near miss ends here instead of after every triangle pair's boxes.
+        if (a.kind() == TreeKind::kObb) {
+            ObbOps roots(c, a.template tree<ObbNode>().nodes().data(),
+                         b.template tree<ObbNode>().nodes().data());
+            roots.prepare();
+            ++c.counters.root_tests;
+            if (roots.separated(0, 0, detail::kNoAxis) >= 0) {
+                ++c.counters.root_rejects;
+                return finish(c, result_);
+            }
+        }
         directPairs(c);
         return finish(c, result_);
     }

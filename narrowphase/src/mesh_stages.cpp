@@ -174,11 +174,10 @@ narrowphase::QuerySettings PairStages::plan(narrowphase::QuerySettings base,
             tree_ = Tree::kOff;
             break;
         case StageMode::kAuto:
-            // Triangle counts are below 2^28 (bv_tree.h): the product fits. A tiny pair that
-            // did not touch keeps the tree: its root test ends a near miss for less than the
-            // direct test's box tests.
-            tree_ = touching_ && trianglesA * trianglesB <= s.tiny_pair_limit ? Tree::kTiny
-                                                                              : Tree::kUsed;
+            // Triangle counts are below 2^28 (bv_tree.h): the product fits. A tiny pair's
+            // direct query tests the root volumes first, so a near miss costs it no more
+            // than the tree's first step.
+            tree_ = trianglesA * trianglesB <= s.tiny_pair_limit ? Tree::kTiny : Tree::kUsed;
             break;
     }
     base.object_spheres = sphere_ == Sphere::kTested;
@@ -249,7 +248,7 @@ void PairStages::report(PairKind kind, const narrowphase::QueryCounters& c, std:
                 break;
         }
     }
-    touching_ = c.pairs > 0;
+    p.add(P::k_root_rejects, c.root_rejects);
     p.add(P::k_node_sphere_tests, c.node_sphere_tests);
     p.add(P::k_node_sphere_rejects, c.node_sphere_rejects);
     p.add(P::k_node_box_tests, c.bv_tests);
@@ -329,7 +328,8 @@ std::string describeStages(const MeshStageStats& s) {
     if (s.no_tree_tiny > 0) {
         out += "; skipped in " + n(s.no_tree_tiny) + " queries of " + n(s.tiny_pairs) +
                " pairs (tiny: triangles(A) * triangles(B) <= " + n(set.tiny_pair_limit) +
-               " and touching in the previous query, every triangle pair tested directly)";
+               ": the root volumes tested, " + n(s.root_rejects) +
+               " of them apart, then every triangle pair directly)";
     }
     if (s.no_tree_off > 0) {
         out += "; skipped in " + n(s.no_tree_off) + " queries (tree off)";

@@ -29,6 +29,7 @@ namespace kolize::detail {
     X(no_tree_tiny)              \
     X(no_tree_off)               \
     X(tiny_pairs)                \
+    X(root_rejects)              \
     X(node_sphere_tests)         \
     X(node_sphere_rejects)       \
     X(node_box_tests)            \
@@ -108,7 +109,6 @@ class PairStages {
     Tree tree_ = Tree::kUsed;
     bool measuring_ = false;  // this query's sphere test belongs to an auto window
     bool offEnded_ = false;   // this query is the last of an off period
-    bool touching_ = false;   // the previous query found intersecting triangles
     int measured_ = 0;        // queries of the current window
     int rejects_ = 0;
     int offLeft_ = 0;  // queries still to skip the test

@@ -64,10 +64,12 @@ struct QuerySettings {
     bool object_spheres = true;
     /// Stage 2: off tests every triangle of A against every triangle of B directly (exact
     /// boxes, then the exact test), without the trees: O(|A| |B|), for tiny meshes, where
-    /// the tree's node tests cost more than they save. Same pairs as the tree path (the
+    /// the tree's node tests cost more than they save. Only the root volumes are tested
+    /// first (OBB trees: the traversal's first test, counted in root_tests and
+    /// root_rejects), so that a near miss ends there. Same pairs as the tree path (the
     /// same per-pair tests on the same doubles), in mesh order (A's triangle, then B's)
-    /// instead of traversal order; the counters of stage 2 stay 0. A query without tree
-    /// forgets the traversal front.
+    /// instead of traversal order; the other counters of stage 2 stay 0. A query without
+    /// tree forgets the traversal front.
     bool use_tree = true;
     Descent descent = Descent::kBoth;
     /// Restart the traversal from the previous query's front (the node pairs where it
@@ -140,6 +142,9 @@ struct QueryCounters {
     std::uint64_t near_pairs = 0;            ///< QueryResult::near's size
     std::uint64_t vertices_transformed = 0;  ///< B's vertices moved into A's frame
     std::uint64_t front_size = 0;            ///< node pairs the traversal started from
+    /// `use_tree` off: 1 when the root volumes were tested first (OBB trees), and rejected.
+    std::uint64_t root_tests = 0;
+    std::uint64_t root_rejects = 0;
     bool started_from_front = false;
     PredicateStats predicates;
 };
