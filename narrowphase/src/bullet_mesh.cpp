@@ -148,13 +148,14 @@ template <class VertexOf>
 void unionByVertex(std::size_t pairCount, VertexOf vertexOf, std::vector<int>& parent,
                    std::vector<int>& last) {
     for (std::size_t i = 0; i < pairCount; ++i) {
+        int y = findRoot(parent, int(i));  // i's root, kept current through its unions
         for (int k = 0; k < 3; ++k) {
             int& seen = last[vertexOf(i, k)];
             if (seen >= 0) {
                 const int x = findRoot(parent, seen);
-                const int y = findRoot(parent, int(i));
                 if (x != y) {
                     parent[std::max(x, y)] = std::min(x, y);  // smallest index: deterministic
+                    y = std::min(x, y);
                 }
             }
             seen = int(i);

@@ -85,7 +85,6 @@ struct QueryScratch::Impl {
     std::vector<NodePair> stack;
     std::vector<NodePair> nextFront;
     std::vector<Triangle> directTriangles;  // B's triangles in A's frame (no-tree queries)
-    std::vector<Vec3> directLo, directHi;
     std::vector<LazyNormal> directNormals;  // their unit normals, computed on first use
     std::vector<double> directBoxes;        // their boxes: lo x, y, z, hi x, y, z runs
     std::vector<std::int32_t> directMet;    // the B triangles whose boxes meet A's
@@ -190,16 +189,36 @@ bool exactPair(Context& c, const Triangle& p, LazyNormal& normalP, const Triangl
     return true;
 }
 
-/// One triangle pair: exact boxes (widened by the contact margin), then exactPair.
-bool trianglePair(Context& c, const Triangle& p, const Vec3& plo, const Vec3& phi,
-                  LazyNormal& normalP, const Triangle& q, const Vec3& qlo, const Vec3& qhi,
-                  LazyNormal& normalQ, std::int32_t ia, std::int32_t ib) {
-    const double m = c.margin;  // 0 without a contact margin: the exact boxes
-    if ((plo.array() - m > qhi.array()).any() || (qlo.array() - m > phi.array()).any()) {
-        ++c.counters.triangle_box_rejects;
-        return true;
+/// B's triangles' boxes, coordinate by coordinate (lo x, y, z, hi x, y, z runs of `stride`),
+/// for a box test of one A triangle against all of them without a branch.
+struct BoxRuns {
+    const double* lo[3];
+    const double* hi[3];
+    BoxRuns(const double* boxes, std::size_t stride) {
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = boxes + k * stride;
+            hi[k] = boxes + (3 + k) * stride;
+        }
     }
-    return exactPair(c, p, normalP, q, normalQ, ia, ib);
+    /// Writes to `met` the j < count whose boxes meet [plo, phi] widened by `m` (the same
+    /// comparisons as trianglePair's), returns how many.
+    std::size_t meeting(const Vec3& plo, const Vec3& phi, double m, std::size_t count,
+                        std::int32_t* met) const {
+        std::size_t metCount = 0;
+        for (std::size_t j = 0; j < count; ++j) {
+            const bool apart = (plo.x() - m > hi[0][j]) | (plo.y() - m > hi[1][j]) |
+                               (plo.z() - m > hi[2][j]) | (lo[0][j] - m > phi.x()) |
+                               (lo[1][j] - m > phi.y()) | (lo[2][j] - m > phi.z());
+            met[metCount] = std::int32_t(j);
+            metCount += apart ? 0 : 1;
+        }
+        return metCount;
+    }
+};
+
+/// A triangle's box outside [lo, hi] widened by `m`: it meets none of the boxes inside.
+bool outside(const Vec3& plo, const Vec3& phi, const Vec3& lo, const Vec3& hi, double m) {
+    return (plo.array() - m > hi.array()).any() || (lo.array() - m > phi.array()).any();
 }
 
 /// Every triangle pair of a leaf pair.
@@ -207,19 +226,32 @@ template <class Node>
 void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const NodeLink& la,
               const NodeLink& lb) {
     ++c.counters.leaf_pairs;
-    Triangle qs[8];
-    Vec3 qlo[8], qhi[8];
-    LazyNormal nq[8] = {LazyNormal(qs[0]), LazyNormal(qs[1]), LazyNormal(qs[2]), LazyNormal(qs[3]),
-                        LazyNormal(qs[4]), LazyNormal(qs[5]), LazyNormal(qs[6]), LazyNormal(qs[7])};
+    constexpr int kMax = 8;  // BvTree's largest leaf
+    Triangle qs[kMax];
+    double boxes[6 * kMax];
+    LazyNormal nq[kMax] = {LazyNormal(qs[0]), LazyNormal(qs[1]), LazyNormal(qs[2]),
+                           LazyNormal(qs[3]), LazyNormal(qs[4]), LazyNormal(qs[5]),
+                           LazyNormal(qs[6]), LazyNormal(qs[7])};
     const int countB = lb.count();
+    Vec3 allLo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 allHi = -allLo;
     for (int j = 0; j < countB; ++j) {
         const Index3& t = tb.slotTriangles()[lb.firstSlot() + j];
         for (int k = 0; k < 3; ++k) {
             qs[j][k] = c.vertexB(t[k]);
         }
-        qlo[j] = qs[j][0].cwiseMin(qs[j][1]).cwiseMin(qs[j][2]);
-        qhi[j] = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
+        const Vec3 lo = qs[j][0].cwiseMin(qs[j][1]).cwiseMin(qs[j][2]);
+        const Vec3 hi = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
+        allLo = allLo.cwiseMin(lo);
+        allHi = allHi.cwiseMax(hi);
+        for (int k = 0; k < 3; ++k) {
+            boxes[k * kMax + j] = lo[k];
+            boxes[(3 + k) * kMax + j] = hi[k];
+        }
     }
+    const BoxRuns runs(boxes, kMax);
+    const double m = c.margin;
+    std::int32_t met[kMax];
     const std::vector<Vec3>& va = c.a.mesh().vertices();
     for (int i = 0; i < la.count(); ++i) {
         const std::int32_t slotA = la.firstSlot() + i;
@@ -227,10 +259,17 @@ void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const 
         const Triangle p = {va[ti[0]], va[ti[1]], va[ti[2]]};
         const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
         const Vec3 phi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
+        if (outside(plo, phi, allLo, allHi, m)) {
+            c.counters.triangle_box_rejects += std::uint64_t(countB);
+            continue;
+        }
+        const std::size_t metCount = runs.meeting(plo, phi, m, std::size_t(countB), met);
+        c.counters.triangle_box_rejects += std::uint64_t(countB) - metCount;
         LazyNormal np(p);
-        for (int j = 0; j < countB; ++j) {
-            if (!trianglePair(c, p, plo, phi, np, qs[j], qlo[j], qhi[j], nq[j],
-                              ta.triangleOrder()[slotA], tb.triangleOrder()[lb.firstSlot() + j])) {
+        for (std::size_t k = 0; k < metCount; ++k) {
+            const std::int32_t j = met[k];
+            if (!exactPair(c, p, np, qs[j], nq[j], ta.triangleOrder()[slotA],
+                           tb.triangleOrder()[lb.firstSlot() + j])) {
                 return;
             }
         }
@@ -244,14 +283,10 @@ void directPairs(Context& c) {
     const TriangleMesh& mb = c.b.mesh();
     const std::size_t countB = mb.triangleCount();
     std::vector<Triangle>& qs = c.scratch.directTriangles;
-    std::vector<Vec3>& qlo = c.scratch.directLo;
-    std::vector<Vec3>& qhi = c.scratch.directHi;
     std::vector<LazyNormal>& nq = c.scratch.directNormals;
     std::vector<double>& boxes = c.scratch.directBoxes;
     std::vector<std::int32_t>& met = c.scratch.directMet;
     qs.resize(countB);
-    qlo.resize(countB);
-    qhi.resize(countB);
     nq.resize(countB);
     boxes.resize(6 * countB);
     met.resize(countB);
@@ -264,16 +299,17 @@ void directPairs(Context& c) {
         for (int k = 0; k < 3; ++k) {
             qs[j][k] = c.vertexB(t[k]);
         }
-        qlo[j] = qs[j][0].cwiseMin(qs[j][1]).cwiseMin(qs[j][2]);
-        qhi[j] = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
-        allLo = allLo.cwiseMin(qlo[j]);
-        allHi = allHi.cwiseMax(qhi[j]);
+        const Vec3 lo = qs[j][0].cwiseMin(qs[j][1]).cwiseMin(qs[j][2]);
+        const Vec3 hi = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
+        allLo = allLo.cwiseMin(lo);
+        allHi = allHi.cwiseMax(hi);
         nq[j] = LazyNormal(qs[j]);
         for (int k = 0; k < 3; ++k) {
-            boxes[k * countB + j] = qlo[j][k];
-            boxes[(3 + k) * countB + j] = qhi[j][k];
+            boxes[k * countB + j] = lo[k];
+            boxes[(3 + k) * countB + j] = hi[k];
         }
     }
+    const BoxRuns runs(boxes.data(), countB);
     const double m = c.margin;
     const std::vector<Vec3>& va = ma.vertices();
     for (std::size_t i = 0; i < ma.triangleCount(); ++i) {
@@ -281,22 +317,13 @@ void directPairs(Context& c) {
         const Triangle p = {va[ti[0]], va[ti[1]], va[ti[2]]};
         const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
         const Vec3 phi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
-        if ((plo.array() - m > allHi.array()).any() || (allLo.array() - m > phi.array()).any()) {
+        if (outside(plo, phi, allLo, allHi, m)) {
             c.counters.triangle_box_rejects += countB;
             continue;
         }
-        // The box test of every B triangle, coordinate by coordinate without a branch (the
-        // same comparisons as trianglePair's); then the exact test of those that met.
-        const double* lo[3] = {&boxes[0], &boxes[countB], &boxes[2 * countB]};
-        const double* hi[3] = {&boxes[3 * countB], &boxes[4 * countB], &boxes[5 * countB]};
-        std::size_t metCount = 0;
-        for (std::size_t j = 0; j < countB; ++j) {
-            const bool apart = (plo.x() - m > hi[0][j]) | (plo.y() - m > hi[1][j]) |
-                               (plo.z() - m > hi[2][j]) | (lo[0][j] - m > phi.x()) |
-                               (lo[1][j] - m > phi.y()) | (lo[2][j] - m > phi.z());
-            met[metCount] = std::int32_t(j);
-            metCount += apart ? 0 : 1;
-        }
+        // The box test of every B triangle without a branch, then the exact test of those
+        // that met.
+        const std::size_t metCount = runs.meeting(plo, phi, m, countB, met.data());
         c.counters.triangle_box_rejects += countB - metCount;
         LazyNormal np(p);
         for (std::size_t k = 0; k < metCount; ++k) {
