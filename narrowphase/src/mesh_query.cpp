@@ -200,8 +200,8 @@ struct BoxRuns {
             hi[k] = boxes + (3 + k) * stride;
         }
     }
-    /// Writes to `met` the j < count whose boxes meet [plo, phi] widened by `m` (the same
-    /// comparisons as trianglePair's), returns how many.
+    /// Writes to `met` the j < count whose boxes meet [plo, phi] widened by `m` (closed
+    /// boxes: apart only when one lies beyond the other along an axis), returns how many.
     std::size_t meeting(const Vec3& plo, const Vec3& phi, double m, std::size_t count,
                         std::int32_t* met) const {
         std::size_t metCount = 0;
