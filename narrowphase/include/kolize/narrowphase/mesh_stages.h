@@ -33,9 +33,11 @@
 ///   deeply as a touching one, and the traversal would visit most of its node pairs to find
 ///   nothing. Re-decided every query (scenery pairs see a different number of scenery
 ///   triangles each time). Measured with `kolize-mesh-stages --query-sweep` (two
-///   12-triangle boxes, contacts mode): resting 12.6 us with the tree, 8.1 us direct; 0.01
-///   apart 0.17 us with the tree (its front keeps the node pair that separated), 0.44 us
-///   direct (a cube's root OBB has arbitrary axes and meets the other cube's).
+///   12-triangle boxes, contacts mode): resting 11.1 us with the tree, 5.4 us direct; 0.01
+///   apart 0.28 us with the tree (its front keeps the node pair that separated), 0.53 us
+///   direct (a cube's root OBB has arbitrary axes and meets the other cube's). Direct also
+///   wins up to 108 x 108 triangles on those boxes, but a larger limit (1296 or 11664) made
+///   kolize-mesh-world's pile of real meshes about 12% slower: the default stays 144.
 /// - Triangle test: every mesh-mesh and mesh-scenery pair that gets past the spheres. A convex
 ///   shape against a mesh (a primitive pair) never runs kolize's triangle stage: Bullet's
 ///   convex-triangle algorithm makes its contacts (counted as convex_mesh_queries).
