@@ -175,8 +175,7 @@ narrowphase::QuerySettings PairStages::plan(narrowphase::QuerySettings base,
             break;
         case StageMode::kAuto:
             // Triangle counts are below 2^28 (bv_tree.h): the product fits. A tiny pair's
-            // direct query tests the root volumes first, so a near miss costs it no more
-            // than the tree's first step.
+            // direct query tests the root volumes first: a near miss they part ends there.
             tree_ = trianglesA * trianglesB <= s.tiny_pair_limit ? Tree::kTiny : Tree::kUsed;
             break;
     }
