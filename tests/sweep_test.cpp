@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <random>
 #include <set>
@@ -33,6 +34,7 @@ Pair ordered(kolize::ObjectId a, kolize::ObjectId b) {
 
 struct Tracked {
     std::size_t frames = 0, pairsSeen = 0, reusedBeforeMaintain = 0, changes = 0;
+    std::size_t oneAxisMoves = 0, oneEndMoves = 0;
 };
 
 Tracked runTracked(std::uint32_t seed, bool lattice) {
@@ -83,10 +85,28 @@ Tracked runTracked(std::uint32_t seed, bool lattice) {
             } else {
                 Box& box = boxes[id];
                 const float step = roll < 0.5f ? 1e-6f : 0.3f;  // jitter or a move
-                for (int axis = 0; axis < 3; ++axis) {
+                const float shape = unit(rng);
+                if (shape < 0.6f) {  // a translation on every axis
+                    for (int axis = 0; axis < 3; ++axis) {
+                        const float d = step * (2 * unit(rng) - 1);
+                        box.lo[axis] += d;
+                        box.hi[axis] += d;
+                    }
+                } else if (shape < 0.8f) {  // one axis only (a fall, a slide)
+                    const int axis = int(rng() % 3);
                     const float d = step * (2 * unit(rng) - 1);
                     box.lo[axis] += d;
                     box.hi[axis] += d;
+                    ++out.oneAxisMoves;
+                } else {  // one end of one axis (a box that grows or shrinks on one side)
+                    const int axis = int(rng() % 3);
+                    const float d = step * unit(rng);
+                    if (rng() % 2 == 0) {
+                        box.lo[axis] = std::min(box.hi[axis], box.lo[axis] + (rng() % 2 ? d : -d));
+                    } else {
+                        box.hi[axis] = std::max(box.lo[axis], box.hi[axis] + (rng() % 2 ? d : -d));
+                    }
+                    ++out.oneEndMoves;
                 }
                 core.update(id, box);
             }
@@ -128,6 +148,9 @@ TEST(SweepTracking, DrainedChangesKeepTheExactPairsUnderMovesJitterAndReusedIds)
             EXPECT_GT(t.pairsSeen, 200u * 20);
             EXPECT_GT(t.changes, 1000u);
             EXPECT_GT(t.reusedBeforeMaintain, 50u);
+            // Moves that keep some intervals (skipped axes must be exactly those).
+            EXPECT_GT(t.oneAxisMoves, 500u);
+            EXPECT_GT(t.oneEndMoves, 500u);
         }
     }
 }

@@ -7,7 +7,8 @@
 /// carried to their new places by adjacent swaps, as Bullet's btAxisSweep3 does; a min
 /// passing another object's max (or the reverse) is where the two intervals start or stop
 /// overlapping on that axis, and when their other axes overlap, the pair is recorded as
-/// changed. Work per frame: O(moved objects + swaps); objects at rest cost nothing.
+/// changed. Work per frame: O(moved objects + swaps); objects at rest cost nothing, and an
+/// axis on which a moved box kept its interval is not touched.
 ///
 /// Unlike btAxisSweep3: the endpoints are the exact box coordinates (no quantisation, so no
 /// world bounds and no extra pairs), ids are 32-bit (no 16-bit handle limit), and objects
@@ -125,11 +126,20 @@ class SweepAndPrune {
 
     /// Moves object `id`: its endpoints swap their way to the new values.
     void update(ObjectId id, const Box& box) {
+        Box& old = boxes_[id];
         if (state_[id] == State::Pending) {
-            boxes_[id] = box;  // sorted objects' boxes live in their endpoints
+            old = box;
             return;
         }
         for (int axis = 0; axis < D; ++axis) {
+            // An axis whose interval did not change costs nothing: falling and sliding
+            // bodies change one or two of the three, and the object's box is one cache line
+            // where the endpoints are six.
+            if (old.lo[axis] == box.lo[axis] && old.hi[axis] == box.hi[axis]) {
+                continue;
+            }
+            old.lo[axis] = box.lo[axis];
+            old.hi[axis] = box.hi[axis];
             std::vector<Endpoint>& edges = axes_[axis];
             const std::uint32_t low = at_[id][2 * axis], high = at_[id][2 * axis + 1];
             edges[low].setValue(box.lo[axis]);
@@ -267,6 +277,11 @@ class SweepAndPrune {
                         if (end == 1 &&
                             axes_[axis][at].value() < axes_[axis][at_[id][2 * axis]].value()) {
                             fail("inverted interval of object " + std::to_string(id));
+                        }
+                        const Scalar kept = end == 1 ? boxes_[id].hi[axis] : boxes_[id].lo[axis];
+                        if (!(axes_[axis][at].value() == kept)) {
+                            fail("endpoint value of object " + std::to_string(id) +
+                                 " differs from its box");
                         }
                     }
                 }
@@ -505,7 +520,7 @@ class SweepAndPrune {
 
     std::array<std::vector<Endpoint>, D> axes_;
     std::vector<State> state_;
-    std::vector<Box> boxes_;
+    std::vector<Box> boxes_;  ///< every object's box (its endpoints' values, once sorted)
     std::vector<Positions> at_;
     std::vector<std::uint32_t> pendingAt_;  ///< index in pending_, or kSettled
     std::vector<ObjectId> pending_;
