@@ -44,9 +44,23 @@ template <class Corners>
 void fitNode(AabbNode& node, const Corners& corners, const Eigen::Matrix3d&) {
     node.volume = detail::fitAabbFrom(corners);
 }
+/// Half the box's surface area: the measure by which two fits of one node are compared
+/// (nonzero for flat parts, and what decides how often a box is met).
+double halfArea(const Obb& box) {
+    const Vec3 h = box.half.cast<double>();
+    return h.x() * h.y() + h.y() * h.z() + h.z() * h.x();
+}
+
 template <class Corners>
 void fitNode(ObbNode& node, const Corners& corners, const Eigen::Matrix3d& axes) {
     node.volume = detail::fitObbFrom(corners, axes);
+    // The principal axes of a box-like part are arbitrary where its spread is equal in two
+    // or three directions (a cube, a square slab), and its box then stands askew; the
+    // model's own axes fit such parts exactly. The smaller of the two boxes is kept.
+    const Obb aligned = detail::fitObbFrom(corners, Eigen::Matrix3d::Identity());
+    if (halfArea(aligned) < halfArea(node.volume)) {
+        node.volume = aligned;
+    }
     node.extentSum = (node.volume.half.x() + node.volume.half.y()) + node.volume.half.z();
 }
 template <int K, class Corners>

@@ -3,6 +3,8 @@
 #include <kolize/narrowphase/mesh_model.h>
 #include <kolize/narrowphase/triangle_mesh.h>
 
+#include "../box_mesh.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -112,6 +114,35 @@ TEST(MeshModel, ObbNodesAreOneCacheLine) {
     const auto mesh = std::make_shared<const TriangleMesh>(
         "tri", square(), std::vector<Index3>{{0, 1, 2}, {0, 2, 3}});
     EXPECT_EQ(MeshModel(mesh).bytesPerNode(), 64u);
+}
+
+// A cube's principal axes are arbitrary (equal spread every way) and a square slab's are in
+// its plane: the root OBB stood askew and up to 1.7 times too wide (the wall scene's ground
+// was 1.2 m thick for a 1 m slab). The fit keeps the model's axes where they are tighter.
+TEST(MeshModel, RootObbOfABoxMeshIsTheBoxItself) {
+    for (const Vec3& h : {Vec3(0.5, 0.5, 0.5), Vec3(100, 0.5, 100), Vec3(0.01, 20, 64)}) {
+        for (int leaf : {1, 4}) {
+            TreeSettings settings;
+            settings.leaf_size = leaf;
+            const MeshModel model(std::make_shared<const TriangleMesh>(kolize::testing::boxMesh(h)),
+                                  settings);
+            EXPECT_EQ(model.validate(), "");
+            const Obb& root = model.tree<ObbNode>().nodes()[0].volume;
+            // The box's half extents along its axes, whatever their order and sign.
+            Vec3 along;
+            const Vec3 axes[3] = {root.axis0.cast<double>(), root.axis1.cast<double>(),
+                                  root.axis2().cast<double>()};
+            for (int k = 0; k < 3; ++k) {
+                along[k] = axes[0].cwiseAbs()[k] * root.half.x() +
+                           axes[1].cwiseAbs()[k] * root.half.y() +
+                           axes[2].cwiseAbs()[k] * root.half.z();
+            }
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_NEAR(along[k], h[k], 1e-5 * h.maxCoeff())
+                    << "box " << h.transpose() << ", leaf size " << leaf << ", axis " << k;
+            }
+        }
+    }
 }
 
 }  // namespace

@@ -121,8 +121,13 @@ inline std::map<workload::PoseClass, ClassTally> compareEverywhere(
         }
         const std::vector<workload::WorkloadPose> poses = workload::makePoses(
             meshA, obbA, meshB, obbB, kind, posesPerClass, seed + std::uint32_t(kind));
-        EXPECT_EQ(int(poses.size()),
-                  exact ? (kind == workload::PoseClass::kShifted ? 3 : 1) : posesPerClass)
+        // Two boxes have their own boxes as root OBBs (the fit keeps the model's axes where
+        // they are tighter), so no pose parts them while their root OBBs overlap.
+        const bool boxes = meshA.name.rfind("box-", 0) == 0 && meshB.name.rfind("box-", 0) == 0;
+        const int expected = exact ? (kind == workload::PoseClass::kShifted ? 3 : 1)
+                             : kind == workload::PoseClass::kApartObb && boxes ? 0
+                                                                               : posesPerClass;
+        EXPECT_EQ(int(poses.size()), expected)
             << meshA.name << " x " << meshB.name << " " << workload::poseClassName(kind);
         for (std::size_t p = 0; p < poses.size(); ++p) {
             const workload::WorkloadPose& pose = poses[p];
