@@ -817,6 +817,77 @@ TEST(Auto, FastCrowdedClusterTakesTheSpatialHashAndAnEvenSpreadTheGrid) {
     }
 }
 
+// A world that rests but never sleeps (a pyramid with deactivation off): every box jitters
+// about its place every frame. When no pair starts or stops overlapping, "auto" moves to the
+// grid, whose fat boxes and pair certificates absorb the jitter (the sweep's endpoints swap
+// among the stack's near-equal coordinates: 4x the grid's time on the pyramid's moving
+// frames). When the jitter makes touching boxes part and meet again (pair changes every
+// frame), it keeps the sweep. Once everything stops, the core stays as it is. Pairs exact
+// throughout, against the plain reference.
+TEST(Auto, RestingJitterTakesTheGridUnlessPairsChangeAndRestKeepsTheCore) {
+    for (const bool touching : {false, true}) {
+        SCOPED_TRACE(touching ? "x neighbours touch: pairs flicker" : "overlaps of 0.1: steady");
+        auto broadphase = makeBroadphase("auto");
+        auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+        std::mt19937 random(12);
+        std::uniform_real_distribution<double> jitter(-1e-4, 1e-4);
+        std::vector<btBroadphaseProxy*> proxies;
+        std::vector<btVector3> home;
+        BoxMap boxes;
+        static char client;
+        const btScalar spacingX = touching ? btScalar(1.0) : btScalar(0.9);
+        for (int i = 0; i < 400; ++i) {
+            const btVector3 lo(spacingX * btScalar(i % 20), btScalar(0.9 * (i / 20 % 10)),
+                               btScalar(0.9 * (i / 200)));
+            home.push_back(lo);
+            ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
+            box.proxy =
+                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+            boxes[box.proxy] = box;
+        }
+        std::size_t changes = 0;
+        std::vector<UidPair> previous;
+        for (int frame = 0; frame < 330; ++frame) {
+            const bool rest = frame >= 230;
+            for (std::size_t i = 0; i < proxies.size() && !rest; ++i) {
+                ProxyBox& box = boxes[proxies[i]];
+                // About its place, not a random walk: the fat boxes hold for good.
+                box.aabbMin =
+                    home[i] + btVector3(btScalar(jitter(random)), btScalar(jitter(random)),
+                                        btScalar(jitter(random)));
+                box.aabbMax = box.aabbMin + btVector3(1, 1, 1);
+                broadphase->setAabb(proxies[i], box.aabbMin, box.aabbMax, nullptr);
+            }
+            const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+            if (frame > 0 && pairs.cached != previous) {
+                ++changes;
+            }
+            previous = pairs.cached;
+            if (frame == 229) {
+                // The sample means something: steady pairs never changed, flickering ones did.
+                if (touching) {
+                    EXPECT_GT(changes, 200u);
+                } else {
+                    EXPECT_EQ(changes, 0u);
+                }
+                const std::string description = adapter.coreDescription();
+                EXPECT_EQ(description.rfind(touching ? "auto: sweep" : "auto: grid", 0), 0u)
+                    << description;
+                if (!touching) {
+                    EXPECT_NE(description.find("resting, jittering"), std::string::npos)
+                        << description;
+                }
+            }
+            adapter.validate();
+        }
+        const std::string atRest = adapter.coreDescription();
+        EXPECT_EQ(atRest.rfind(touching ? "auto: sweep" : "auto: grid", 0), 0u) << atRest;
+        EXPECT_NE(atRest.find("at rest"), std::string::npos) << atRest;
+    }
+}
+
 // Found by the fuzzer (seed 1, shrunk): "auto" switched to sweep after two searches of an
 // empty world; resetPool then restarted its core on the grid while the adapter still took it
 // for a core that tracks overlaps, and the next pair of overlapping proxies was never found.

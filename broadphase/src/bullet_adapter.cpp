@@ -306,7 +306,7 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
         if (sampleMotion_) {
-            noteMotion(boxes_[slot], box);
+            noteMotion(slot, box);
         }
         if (coreTracksOverlaps_) {
             // The core finds the changed pairs itself: no fat box, no certificate.
@@ -345,7 +345,11 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
 }
 
 BroadphaseAdapter::Box BroadphaseAdapter::fatBox(const Box& box, const Box& previous) const {
-    if (settings_.fatMargin == 0 || coreTracksOverlaps_) {
+    return coreTracksOverlaps_ ? box : enlargedBox(box, previous);
+}
+
+BroadphaseAdapter::Box BroadphaseAdapter::enlargedBox(const Box& box, const Box& previous) const {
+    if (settings_.fatMargin == 0) {
         return box;
     }
     btScalar extent = 0, magnitude = 0, moved = 0;
@@ -393,7 +397,18 @@ void BroadphaseAdapter::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax
     aabbMax.setValue(all.hi[0], all.hi[1], all.hi[2]);
 }
 
-void BroadphaseAdapter::noteMotion(const Box& from, const Box& to) {
+void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
+    const Box& from = boxes_[slot];
+    // Would a fat box have held this move? With fat boxes, it is the core box; while the
+    // core tracks overlaps, fat_ is a shadow kept up to date only here (in sampled frames,
+    // so a slow drift counts more leavings than the fat boxes would have: the measure
+    // errs towards the sweep).
+    if (!contains(fat_[slot], to)) {
+        measuredFatExits_ += 1;
+        if (coreTracksOverlaps_) {
+            fat_[slot] = enlargedBox(to, from);
+        }
+    }
     double size = 0;
     for (int axis = 0; axis < 3; ++axis) {
         size = std::max(size, double(to.hi[axis]) - double(to.lo[axis]));
@@ -822,6 +837,14 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     out.frames = double(measuredFrames_);
     out.movedPerFrame = measuredChanges_ / std::max<double>(1, double(measuredMotionFrames_));
     out.relativeMotion = measuredChanges_ > 0 ? measuredMotion_ / measuredChanges_ : 0;
+    out.fatExitsPerMove = measuredChanges_ > 0 ? measuredFatExits_ / measuredChanges_ : 0;
+    const std::size_t pairChanges = counters_.pairsAdded + counters_.pairsRemoved;
+    const double moves = out.movedPerFrame * out.frames;
+    const std::size_t newChanges =
+        pairChanges >= pairChangesSeen_ ? pairChanges - pairChangesSeen_ : 0;
+    out.pairChangesPerMove = moves > 0 ? double(newChanges) / moves : 0;
+    pairChangesSeen_ = pairChanges;
+    measuredFatExits_ = 0;
     out.raysPerFrame = measuredRays_ / frames;
     const double meanRayLength = measuredRays_ > 0 ? measuredRayLength_ / measuredRays_ : 0;
     out.boxQueriesPerFrame = measuredQueries_ / frames;

@@ -279,6 +279,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// The core box for `box`, which replaces `previous`: enlarged when the object moved
     /// less than the margin, else `box` itself.
     Box fatBox(const Box& box, const Box& previous) const;
+    /// The same, whatever the core: the fat box `box` would get (auto's measure uses it as
+    /// a shadow while the core tracks overlaps).
+    Box enlargedBox(const Box& box, const Box& previous) const;
     /// The largest change of any bound, rounded up.
     static double motion(const Box& from, const Box& to);
     /// Whether the closed boxes overlap, and the motion (rounded down) that could change
@@ -377,7 +380,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     // --- for "auto": the scene's measure, and a switch of core without losing a pair ---
     /// Starts measuring (motion per setAabb, rays and box queries).
     void startMeasuring() { measuring_ = true; }
-    void noteMotion(const Box& from, const Box& to);
+    /// A sampled setAabb of `slot` to `to` (boxes_[slot] still the previous box): its motion
+    /// and whether it left the object's fat box.
+    void noteMotion(ObjectId slot, const Box& to);
     /// What was measured since the last call; resets the accumulators. O(sampled objects).
     SceneMeasure takeMeasure();
     /// Before the core is replaced: every pair tested (statuses current, the cache
@@ -395,8 +400,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     bool sampleMotion_ = false;  ///< this frame's setAabb calls feed the motion measure
     bool forceFullSearch_ = false;
     double measuredChanges_ = 0, measuredMotion_ = 0, measuredRays_ = 0, measuredQueries_ = 0,
-           measuredRayLength_ = 0;
+           measuredRayLength_ = 0, measuredFatExits_ = 0;
     std::size_t measuredFrames_ = 0, measuredMotionFrames_ = 0;
+    std::size_t pairChangesSeen_ = 0;  ///< pairsAdded + pairsRemoved at the last measure
 };
 
 /// A btBroadphaseInterface over a kolize core. `Core` provides insert / update / remove,
