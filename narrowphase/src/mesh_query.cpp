@@ -2,6 +2,7 @@
 
 #include "bv_internal.h"
 #include "pose_internal.h"
+#include "triangle_test_internal.h"
 
 #include <Eigen/Geometry>
 
@@ -61,6 +62,43 @@ class LazyNormal {
     bool known_ = false;
 };
 
+/// A triangle's plane for the exact test (detail::PlaneSide), built on first use: a
+/// triangle meets several of the other mesh's in one query.
+class LazyPlane {
+  public:
+    LazyPlane() = default;
+    explicit LazyPlane(const Triangle& t) : t_(&t) {}
+    void reset(const Triangle& t) {
+        t_ = &t;
+        known_ = false;
+    }
+    const detail::PlaneSide& get() {
+        if (!known_) {
+            plane_ = detail::PlaneSide((*t_)[0], (*t_)[1], (*t_)[2]);
+            known_ = true;
+        }
+        return plane_;
+    }
+
+  private:
+    const Triangle* t_ = nullptr;
+    detail::PlaneSide plane_;
+    bool known_ = false;
+};
+
+/// What the leaf tests keep of one triangle: its vertices' normal and plane, on first use.
+struct LazyTriangle {
+    LazyTriangle() = default;
+    explicit LazyTriangle(const Triangle& t) : normal(t), plane(t) {}
+    /// For triangle t, nothing known yet (reuses the memory of a kept entry).
+    void reset(const Triangle& t) {
+        normal = LazyNormal(t);
+        plane.reset(t);
+    }
+    LazyNormal normal;
+    LazyPlane plane;
+};
+
 }  // namespace
 
 struct MeshQuery::Front {
@@ -85,7 +123,7 @@ struct QueryScratch::Impl {
     std::vector<NodePair> stack;
     std::vector<NodePair> nextFront;
     std::vector<Triangle> directTriangles;  // B's triangles in A's frame (no-tree queries)
-    std::vector<LazyNormal> directNormals;  // their unit normals, computed on first use
+    std::vector<LazyTriangle> directLazy;   // their unit normals and planes, on first use
     std::vector<double> directBoxes;        // their boxes: lo x, y, z, hi x, y, z runs
     std::vector<std::int32_t> directMet;    // the B triangles whose boxes meet A's
 
@@ -147,9 +185,10 @@ struct Context {
 };
 
 /// One triangle pair whose boxes overlap: facing filter, exact test; records a hit under the
-/// mesh triangle indices (ia, ib). Returns false when a yes/no query must stop.
-bool exactPair(Context& c, const Triangle& p, LazyNormal& normalP, const Triangle& q,
-               LazyNormal& normalQ, std::int32_t ia, std::int32_t ib) {
+/// mesh triangle indices (ia, ib). Each triangle's plane is built once per query (lazyP,
+/// lazyQ). Returns false when a yes/no query must stop.
+bool exactPair(Context& c, const Triangle& p, LazyTriangle& lazyP, const Triangle& q,
+               LazyTriangle& lazyQ, std::int32_t ia, std::int32_t ib) {
     if (c.settings.facing_filter) {
         const Vec3 na = (p[1] - p[0]).cross(p[2] - p[0]);
         const Vec3 nb = (q[1] - q[0]).cross(q[2] - q[0]);
@@ -160,12 +199,14 @@ bool exactPair(Context& c, const Triangle& p, LazyNormal& normalP, const Triangl
     }
     ++c.counters.triangle_tests;
     const QueryMode mode = c.settings.mode;
+    PredicateStats* stats = &c.counters.predicates;
     bool hit;
     TriangleIntersection geometry;
     if (mode == QueryMode::kContacts) {
-        hit = triangleIntersection(p, q, geometry, &c.counters.predicates);
+        hit = detail::triangleIntersection(p, lazyP.plane.get(), q, lazyQ.plane.get(), geometry,
+                                           stats);
     } else {
-        hit = trianglesIntersect(p, q, &c.counters.predicates);
+        hit = detail::trianglesIntersect(p, lazyP.plane.get(), q, lazyQ.plane.get(), stats);
     }
     if (!hit) {
         if (c.margin > 0 && c.result.pairs.empty()) {  // near pairs only while apart
@@ -180,7 +221,7 @@ bool exactPair(Context& c, const Triangle& p, LazyNormal& normalP, const Triangl
     c.result.pairs.push_back(pair);
     ++c.counters.pairs;
     if (mode == QueryMode::kContacts) {
-        c.result.contacts.push_back({pair, geometry, normalP.get(), normalQ.get()});
+        c.result.contacts.push_back({pair, geometry, lazyP.normal.get(), lazyQ.normal.get()});
     }
     if (mode == QueryMode::kYesNo) {
         c.stop = true;
@@ -229,9 +270,9 @@ void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const 
     constexpr int kMax = 8;  // BvTree's largest leaf
     Triangle qs[kMax];
     double boxes[6 * kMax];
-    LazyNormal nq[kMax] = {LazyNormal(qs[0]), LazyNormal(qs[1]), LazyNormal(qs[2]),
-                           LazyNormal(qs[3]), LazyNormal(qs[4]), LazyNormal(qs[5]),
-                           LazyNormal(qs[6]), LazyNormal(qs[7])};
+    LazyTriangle nq[kMax] = {LazyTriangle(qs[0]), LazyTriangle(qs[1]), LazyTriangle(qs[2]),
+                             LazyTriangle(qs[3]), LazyTriangle(qs[4]), LazyTriangle(qs[5]),
+                             LazyTriangle(qs[6]), LazyTriangle(qs[7])};
     const int countB = lb.count();
     Vec3 allLo = Vec3::Constant(std::numeric_limits<double>::infinity());
     Vec3 allHi = -allLo;
@@ -265,7 +306,7 @@ void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const 
         }
         const std::size_t metCount = runs.meeting(plo, phi, m, std::size_t(countB), met);
         c.counters.triangle_box_rejects += std::uint64_t(countB) - metCount;
-        LazyNormal np(p);
+        LazyTriangle np(p);
         for (std::size_t k = 0; k < metCount; ++k) {
             const std::int32_t j = met[k];
             if (!exactPair(c, p, np, qs[j], nq[j], ta.triangleOrder()[slotA],
@@ -283,7 +324,7 @@ void directPairs(Context& c) {
     const TriangleMesh& mb = c.b.mesh();
     const std::size_t countB = mb.triangleCount();
     std::vector<Triangle>& qs = c.scratch.directTriangles;
-    std::vector<LazyNormal>& nq = c.scratch.directNormals;
+    std::vector<LazyTriangle>& nq = c.scratch.directLazy;
     std::vector<double>& boxes = c.scratch.directBoxes;
     std::vector<std::int32_t>& met = c.scratch.directMet;
     qs.resize(countB);
@@ -303,7 +344,7 @@ void directPairs(Context& c) {
         const Vec3 hi = qs[j][0].cwiseMax(qs[j][1]).cwiseMax(qs[j][2]);
         allLo = allLo.cwiseMin(lo);
         allHi = allHi.cwiseMax(hi);
-        nq[j] = LazyNormal(qs[j]);
+        nq[j].reset(qs[j]);
         for (int k = 0; k < 3; ++k) {
             boxes[k * countB + j] = lo[k];
             boxes[(3 + k) * countB + j] = hi[k];
@@ -325,7 +366,7 @@ void directPairs(Context& c) {
         // that met.
         const std::size_t metCount = runs.meeting(plo, phi, m, countB, met.data());
         c.counters.triangle_box_rejects += countB - metCount;
-        LazyNormal np(p);
+        LazyTriangle np(p);
         for (std::size_t k = 0; k < metCount; ++k) {
             const std::int32_t j = met[k];
             if (!exactPair(c, p, np, qs[j], nq[j], std::int32_t(i), j)) {

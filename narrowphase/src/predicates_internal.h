@@ -31,6 +31,8 @@ int orient2dExact(double ax, double ay, double bx, double by, double cx, double 
 /// (a sum of three coordinate-times-2x2-minor terms), so kOrient3dBound holds.
 class PlaneSide {
   public:
+    /// Uninitialised: to be assigned a plane before use.
+    PlaneSide() {}
     PlaneSide(const Vec3& a, const Vec3& b, const Vec3& c) : a_(a), b_(b), c_(c) {
         const double bx = b.x() - a.x(), by = b.y() - a.y(), bz = b.z() - a.z();
         const double cx = c.x() - a.x(), cy = c.y() - a.y(), cz = c.z() - a.z();

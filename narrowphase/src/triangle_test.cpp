@@ -1,6 +1,7 @@
 #include "kolize/narrowphase/triangle_test.h"
 
 #include "predicates_internal.h"
+#include "triangle_test_internal.h"
 
 #include <Eigen/Geometry>
 
@@ -303,17 +304,17 @@ struct Decision {
     bool hit = false;
 };
 
-Decision decide(const Triangle& p, const Triangle& q, PredicateStats* stats) {
+/// planeP and planeQ: the planes of p's and q's vertices in their order.
+Decision decide(const Triangle& p, const PlaneSide& planeP, const Triangle& q,
+                const PlaneSide& planeQ, PredicateStats* stats) {
     Decision d;
     const Tester t(stats);
-    const PlaneSide planeP(p[0], p[1], p[2]);
     for (int k = 0; k < 3; ++k) {
         d.sq[k] = planeP.side(q[k], stats);
     }
     if (sameStrictSide(d.sq)) {
         return d;
     }
-    const PlaneSide planeQ(q[0], q[1], q[2]);
     for (int i = 0; i < 3; ++i) {
         d.sp[i] = planeQ.side(p[i], stats);
     }
@@ -367,6 +368,10 @@ Decision decide(const Triangle& p, const Triangle& q, PredicateStats* stats) {
     d.kind = Decision::Case::kGeneral;
     d.hit = generalHit(t, p, q, d.sp, d.sq);
     return d;
+}
+
+Decision decide(const Triangle& p, const Triangle& q, PredicateStats* stats) {
+    return decide(p, PlaneSide(p[0], p[1], p[2]), q, PlaneSide(q[0], q[1], q[2]), stats);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -620,6 +625,21 @@ double TriangleIntersection::measure() const {
         twiceArea += (points[i] - points[0]).cross(points[i + 1] - points[0]);
     }
     return 0.5 * twiceArea.norm();
+}
+
+bool detail::trianglesIntersect(const Triangle& p, const PlaneSide& planeP, const Triangle& q,
+                                const PlaneSide& planeQ, PredicateStats* stats) {
+    return decide(p, planeP, q, planeQ, stats).hit;
+}
+
+bool detail::triangleIntersection(const Triangle& p, const PlaneSide& planeP, const Triangle& q,
+                                  const PlaneSide& planeQ, TriangleIntersection& out,
+                                  PredicateStats* stats) {
+    const Decision d = decide(p, planeP, q, planeQ, stats);
+    if (d.hit) {
+        buildGeometry(p, q, d, out);
+    }
+    return d.hit;
 }
 
 bool trianglesIntersect(const Triangle& p, const Triangle& q, PredicateStats* stats) {
