@@ -888,6 +888,95 @@ TEST(Auto, RestingJitterTakesTheGridUnlessPairsChangeAndRestKeepsTheCore) {
     }
 }
 
+/// The number in "<number> endpoints passed per moved object" of a core description.
+double passedInDescription(const std::string& description) {
+    const std::size_t at = description.find(" endpoints passed per moved object");
+    if (at == std::string::npos) {
+        return -1;
+    }
+    const std::size_t start = description.rfind('(', at);
+    return std::stod(description.substr(start + 1, at - start - 1));
+}
+
+// Slow motion (a tenth of a box per frame) in which every move passes many endpoints: the
+// boxes' x-intervals start at one of two values, so a box that changes value passes about
+// half of each value's ties. The sweep would swap hundreds of endpoints per move; "auto"
+// must see that under the grid it starts on (an estimate from sampled moves and boxes, no
+// sorted arrays) and keep the grid. The same motion with the boxes' x-intervals spread far
+// apart passes nothing: the sweep. The estimate is checked against a plain count over the
+// boxes of the previous frame.
+TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
+    for (const bool tied : {true, false}) {
+        SCOPED_TRACE(tied ? "x-intervals tied at two values" : "x-intervals spread apart");
+        auto broadphase = makeBroadphase("auto");
+        auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+        std::mt19937 random(7);
+        std::bernoulli_distribution flip(0.5);
+        std::vector<btBroadphaseProxy*> proxies;
+        std::vector<btScalar> base;
+        BoxMap boxes;
+        static char client;
+        for (int i = 0; i < 400; ++i) {
+            // y and z on a lattice 1.5 apart (unit boxes: no two overlap, no pair ever).
+            base.push_back(tied ? btScalar(0) : btScalar(3 * i));
+            const btVector3 lo(base.back(), btScalar(1.5 * (i % 20)), btScalar(1.5 * (i / 20)));
+            ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
+            box.proxy =
+                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+            boxes[box.proxy] = box;
+        }
+        double counted = 0, moves = 0;
+        for (int frame = 0; frame < 100; ++frame) {
+            // A plain count: endpoints of the other boxes (as the frame starts) between
+            // where a moved box's x-ends were and where they go, ties counted half.
+            std::vector<btScalar> ends;
+            for (const auto& entry : boxes) {
+                ends.push_back(entry.second.aabbMin.x());
+                ends.push_back(entry.second.aabbMax.x());
+            }
+            for (std::size_t i = 0; i < proxies.size(); ++i) {
+                ProxyBox& box = boxes[proxies[i]];
+                const btScalar x = base[i] + (flip(random) ? btScalar(0.1) : btScalar(0));
+                if (x == box.aabbMin.x()) {
+                    continue;
+                }
+                for (const auto& end :
+                     {std::make_pair(box.aabbMin.x(), x), std::make_pair(box.aabbMax.x(), x + 1)}) {
+                    const btScalar lo = std::min(end.first, end.second);
+                    const btScalar hi = std::max(end.first, end.second);
+                    for (const btScalar e : ends) {
+                        counted += (e > lo && e < hi) ? 1.0 : (e == lo || e == hi) ? 0.5 : 0.0;
+                    }
+                    counted -= 0.5;  // its own end, at `first`
+                }
+                moves += 1;
+                box.aabbMin.setX(x);
+                box.aabbMax.setX(x + 1);
+                broadphase->setAabb(proxies[i], box.aabbMin, box.aabbMax, nullptr);
+            }
+            const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+            ASSERT_TRUE(pairs.truth.empty()) << "frame " << frame;
+        }
+        adapter.validate();
+        const std::string description = adapter.coreDescription();
+        ASSERT_GT(moves, 100 * 150);  // the sample means something: most boxes move
+        const double plain = counted / moves;
+        const double estimated = passedInDescription(description);
+        if (tied) {
+            EXPECT_GT(plain, 300);  // each move passes about half of 2 x 400 tied ends
+            EXPECT_EQ(description.rfind("auto: grid", 0), 0u) << description;
+            EXPECT_NE(description.find("would swap much"), std::string::npos) << description;
+        } else {
+            EXPECT_EQ(plain, 0);
+            EXPECT_EQ(description.rfind("auto: sweep", 0), 0u) << description;
+        }
+        // The estimate (a sample of moves against a sample of boxes) agrees with the count.
+        EXPECT_NEAR(estimated, plain, 0.25 * plain + 1) << description;
+    }
+}
+
 // Found by the fuzzer (seed 1, shrunk): "auto" switched to sweep after two searches of an
 // empty world; resetPool then restarted its core on the grid while the adapter still took it
 // for a core that tracks overlaps, and the next pair of overlapping proxies was never found.

@@ -415,6 +415,59 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     }
     measuredChanges_ += 1;
     measuredMotion_ += std::min(1e3, motion(from, to) / std::max(size, 1e-30));
+    // A uniform sample of the moves (reservoir; a fixed-seed generator, so a replayed
+    // stream gets the same sample and the same choices).
+    const std::size_t seen = std::size_t(measuredChanges_);
+    if (sampledMoves_.size() < kSwapSampleMoves) {
+        sampledMoves_.push_back({from, to});
+    } else {
+        moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
+        const std::size_t at = std::size_t((moveSampleState_ >> 33) % seen);
+        if (at < kSwapSampleMoves) {
+            sampledMoves_[at] = {from, to};
+        }
+    }
+}
+
+double BroadphaseAdapter::estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots) const {
+    if (sampledMoves_.empty() || sampledSlots.empty() ||
+        liveCount_ - parkedCount_ < kSwapEstimateFrom) {
+        return 0;
+    }
+    // Every stride-th of the sampled boxes: the estimate needs a density, not every end.
+    const std::size_t stride = sampledSlots.size() / kSwapSampleBoxes + 1;
+    const std::size_t boxCount = (sampledSlots.size() + stride - 1) / stride;
+    std::vector<btScalar> ends;
+    ends.reserve(2 * boxCount);
+    double passed = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        ends.clear();
+        for (std::size_t at = 0; at < sampledSlots.size(); at += stride) {
+            ends.push_back(boxes_[sampledSlots[at]].lo[axis]);
+            ends.push_back(boxes_[sampledSlots[at]].hi[axis]);
+        }
+        std::sort(ends.begin(), ends.end());
+        // Endpoints between where an end was and where it went: those strictly between,
+        // and half of those equal to either value (ties are ordered by id: a moving end
+        // passes about half of its old and of its new value's).
+        auto between = [&](btScalar a, btScalar b) {
+            if (!(a < b || b < a)) {
+                return 0.0;
+            }
+            const btScalar lo = std::min(a, b), hi = std::max(a, b);
+            const auto loFirst = std::lower_bound(ends.begin(), ends.end(), lo);
+            const auto loLast = std::upper_bound(loFirst, ends.end(), lo);
+            const auto hiFirst = std::lower_bound(loLast, ends.end(), hi);
+            const auto hiLast = std::upper_bound(hiFirst, ends.end(), hi);
+            return double(hiFirst - loLast) + 0.5 * double((loLast - loFirst) + (hiLast - hiFirst));
+        };
+        for (const SampledMove& move : sampledMoves_) {
+            passed += between(move.from.lo[axis], move.to.lo[axis]) +
+                      between(move.from.hi[axis], move.to.hi[axis]);
+        }
+    }
+    const double scale = double(liveCount_ - parkedCount_) / double(boxCount);
+    return passed * scale / double(sampledMoves_.size());
 }
 
 bool BroadphaseAdapter::usableQueryBox(const btVector3& aabbMin, const btVector3& aabbMax) {
@@ -855,11 +908,13 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     // boxes over 1e6 m left out).
     std::vector<double> sizes;
     std::vector<std::array<double, 3>> centres;
+    std::vector<ObjectId> sampledSlots;
     const std::size_t stride = boxes_.size() / 1024 + 1;
     for (std::size_t slot = 0; slot < boxes_.size(); slot += stride) {
         if (state_[slot] != SlotState::Live) {
             continue;
         }
+        sampledSlots.push_back(ObjectId(slot));
         const Box& box = boxes_[slot];
         double size = 0;
         std::array<double, 3> centre;
@@ -872,13 +927,18 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
             centres.push_back(centre);
         }
     }
+    out.swapsPerMove = estimateSwapsPerMove(sampledSlots);
+    sampledMoves_.clear();
     if (sizes.size() < 8) {
         return out;
     }
-    std::vector<double> sorted = sizes;
-    std::sort(sorted.begin(), sorted.end());
-    const double p10 = sorted[sorted.size() / 10], p90 = sorted[sorted.size() * 9 / 10];
-    const double median = sorted[sorted.size() / 2];
+    // Three order statistics (selection, not a sort).
+    auto rank = [&](std::size_t k) {
+        std::nth_element(sizes.begin(), sizes.begin() + long(k), sizes.end());
+        return sizes[k];
+    };
+    const double p10 = rank(sizes.size() / 10), p90 = rank(sizes.size() * 9 / 10);
+    const double median = rank(sizes.size() / 2);
     out.rayLength = median > 0 ? meanRayLength / median : (meanRayLength > 0 ? 1e9 : 0);
     out.sizeSpread = p10 > 0 ? p90 / p10 : (p90 > 0 ? 1e9 : 1);
     out.medianSize = median;

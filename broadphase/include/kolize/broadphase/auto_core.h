@@ -26,11 +26,16 @@
 ///   sweep's endpoints swap among the near-equal coordinates of a stack (pyramid, moving
 ///   frames: grid 0.019 ms, sweep 0.080);
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
-///   most Bullet worlds, resting or settling): sweep. Where the grid beats it otherwise
-///   (mixed-terrain and offset-1e6 over their first 100 frames), nothing measured before
-///   the choice separated those scenes from ones where the sweep is 2-7x faster (the swaps
-///   per moved object and the grid's crowding, both in the reason, were tried; at 300
-///   frames mixed-terrain and mixed-plane favour the sweep again);
+///   most Bullet worlds, resting or settling) in which a sorted sweep would swap much: the
+///   estimated endpoints passed per moved object (SceneMeasure::swapsPerMove, known under
+///   any core) at least 30 x (1 + half the grid's crowding), under 0.1 pair changes per
+///   move: grid. Float coordinates far from the origin (offset-1e6: 50-75 passed, the grid
+///   0.7x of the sweep's time) and boxes settling on a lattice of equal coordinates
+///   (pyramid, and bench-1000-stack's first frames) pass many equal endpoints that the
+///   grid's cells never order;
+/// - slow motion otherwise: sweep. (mixed-terrain, mixed-plane and offset-1e4 favour the
+///   grid over their first 64-96 frames, with 43-103 passed; the two evaluations a switch
+///   needs come too late there, and over 300 frames the sweep wins.)
 /// - faster motion, and the dense grid would crowd (its cells, enlarged to fit its budget of
 ///   cells per object over the objects' bounds, would put more than 16 + 2x as many other
 ///   objects beside an object as the sparse cells do: a cluster in a large space, as the
@@ -74,6 +79,10 @@ struct SceneMeasure {
     /// Pairs that started or stopped overlapping (added to or removed from the pair cache),
     /// per moved object.
     double pairChangesPerMove = 0;
+    /// Endpoints that a sorted sweep's moved box would pass per move (each axis, both
+    /// ends), estimated under any core: a sample of the moves against the endpoints of a
+    /// sample of the boxes, scaled to all of them.
+    double swapsPerMove = 0;
     double sizeSpread = 1;  ///< 90th over 10th percentile of box sizes (sampled)
     double medianSize = 0;  ///< median largest extent of the sampled boxes
     /// Centres of a sample of the boxes (at most 1024, planes and boxes over 1e6 left out).
@@ -128,13 +137,6 @@ class AutoCore {
     /// hysteresis); sets reason().
     Kind decide(const SceneMeasure& measure) {
         framesSinceSwitch_ += std::size_t(measure.frames);
-        if (kind_ == Kind::Sweep) {
-            // The sweep's own cost measure: endpoint swaps per moved object since the last
-            // evaluation.
-            const double moves = measure.movedPerFrame * measure.frames;
-            swapsPerMove_ = moves > 0 ? double(sweep_.swaps() - swapsSeen_) / moves : 0;
-            swapsSeen_ = sweep_.swaps();
-        }
         const Kind wanted = rule(measure);
         ++evaluations_;
         if (wanted == kind_) {
@@ -159,7 +161,6 @@ class AutoCore {
         hash_ = SpatialHash<D, Scalar>(settings_.cells);
         trees_ = SegmentTreeSet<D, Scalar>(noKeptSet(settings_.segmentTrees));
         sweep_ = SweepAndPrune<D, Scalar>();
-        swapsSeen_ = 0;
         kind_ = kind;
         pending_ = kind;
         reason_ = why;
@@ -221,6 +222,22 @@ class AutoCore {
     /// 0.019-0.037 pair changes per move: the sweep 0.063, grid 0.073) and
     /// bench-convex-pack's (0.0035-0.0066, 0.0049-0.011); every other scene of the
     /// registry leaves a fat box in over 0.07 of its moves.
+    /// Slow motion with many swaps: the grid when the estimated endpoints passed per moved
+    /// object reach kManySwaps times (1 + half the grid's crowding). A sweep's moved object
+    /// costs about 0.07 us + 4 ns per endpoint passed + 0.2 us per pair change (fitted);
+    /// the grid's grows with the others beside it. Chosen on 20 recorded streams of the
+    /// registry, the features of one 32-frame window against the replayed times of the
+    /// next. Replayed with the rule, it put auto on the grid in 9 windows (the first of
+    /// pyramid and bench-1000-stack, offset-1e6's from frame 96 on: 50-75 passed, 0.75
+    /// others), where the grid took 0.30-0.77x of the sweep's time, and in none where the
+    /// sweep was faster; it keeps the sweep for falling boxes (bench-3000-boxes: 39-84
+    /// passed, 4-15 others, the sweep 0.55-0.65x of the grid) and bench-prim-mesh (27-36,
+    /// 6-12).
+    static constexpr double kManySwaps = 30;
+    /// ... and under this many pair changes per move: every change costs the grid a pair
+    /// look where the sweep has found it already (the windows where the grid won had at
+    /// most 0.054; falling boxes that pile up, 0.1-1.5).
+    static constexpr double kManySwapsPairChanges = 0.1;
     static constexpr double kJitterWindow = 16;
     static constexpr double kJitterFatExits = 0.01;
     static constexpr double kJitterPairChanges = 0.002;
@@ -262,9 +279,19 @@ class AutoCore {
                                        " objects moved per frame, by " +
                                        shortNumber(m.relativeMotion) + " of their size)";
             const double crowd = crowding(m, denseCell(m, sparseCell(m)));
-            ruleReason_ = motion + ": sorted endpoints move few places (" +
-                          shortNumber(swapsPerMove_) + " swaps per moved object; " +
-                          shortNumber(crowd) + " others in an object's grid cell)";
+            const std::string swaps = shortNumber(m.swapsPerMove) +
+                                      " endpoints passed per moved object; " + shortNumber(crowd) +
+                                      " others in an object's grid cell";
+            // The first evaluation's pair changes are the world's first pairs, not motion.
+            const double pairChanges = evaluations_ > 0 ? m.pairChangesPerMove : 0;
+            if (m.swapsPerMove >= kManySwaps * (1 + crowd / 2) &&
+                pairChanges < kManySwapsPairChanges) {
+                ruleReason_ = motion + ", but sorted endpoints would swap much (" + swaps +
+                              "): the grid's cells and fat boxes do not see the order";
+                return Kind::Grid;
+            }
+            ruleReason_ = motion + ": sorted endpoints move few places (" + swaps + "; " +
+                          shortNumber(m.pairChangesPerMove) + " pair changes per move)";
             return Kind::Sweep;
         }
         const double sparse = sparseCell(m), dense = denseCell(m, sparse);
@@ -314,13 +341,17 @@ class AutoCore {
         if (samples < 2 || !(cell > 0)) {
             return 0;
         }
-        std::vector<std::array<long long, 3>> keys;
+        // A cell's three indices hashed into one word (sorting words is several times
+        // faster than sorting triples; two cells share a hash with odds of about
+        // samples^2 / 2^64, which would count one more sharing pair).
+        std::vector<std::uint64_t> keys;
         keys.reserve(samples);
         for (const auto& c : m.centres) {
-            std::array<long long, 3> key;
+            std::uint64_t key = 0;
             for (int axis = 0; axis < 3; ++axis) {
-                key[axis] =
+                const auto index =
                     static_cast<long long>(std::floor(std::clamp(c[axis] / cell, -1e15, 1e15)));
+                key = mix(key ^ (static_cast<std::uint64_t>(index) + std::uint64_t(axis)));
             }
             keys.push_back(key);
         }
@@ -337,6 +368,14 @@ class AutoCore {
         }
         const double n = double(std::max(m.objects, samples));
         return sharing / double(samples) * (n - 1) / double(samples - 1);
+    }
+
+    /// A 64-bit mixing function (splitmix64's finaliser).
+    static std::uint64_t mix(std::uint64_t x) {
+        x += 0x9e3779b97f4a7c15u;
+        x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9u;
+        x = (x ^ (x >> 27)) * 0x94d049bb133111ebu;
+        return x ^ (x >> 31);
     }
 
     static std::string shortNumber(double x) {
@@ -381,9 +420,6 @@ class AutoCore {
     Kind pending_ = Kind::Grid;
     std::string reason_ = "the start: no measure yet, the grid";
     std::string ruleReason_;
-    double swapsPerMove_ = 0;  ///< the sweep's swaps per moved object, last window it ran
-                               ///< (shown in the reason)
-    std::size_t swapsSeen_ = 0;
     std::size_t evaluations_ = 0;
     std::size_t framesSinceSwitch_ = 0;
     std::size_t switches_ = 0;

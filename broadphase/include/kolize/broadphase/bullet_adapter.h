@@ -403,6 +403,20 @@ class BroadphaseAdapter : public btBroadphaseInterface {
            measuredRayLength_ = 0, measuredFatExits_ = 0;
     std::size_t measuredFrames_ = 0, measuredMotionFrames_ = 0;
     std::size_t pairChangesSeen_ = 0;  ///< pairsAdded + pairsRemoved at the last measure
+    /// At most this many sampled moves per measure are kept for the swap estimate, and at
+    /// most kSwapSampleBoxes boxes' endpoints counted against them; below kSwapEstimateFrom
+    /// live objects there is no estimate (0: a sweep of so few is cheap whatever it swaps).
+    static constexpr std::size_t kSwapSampleMoves = 48;
+    static constexpr std::size_t kSwapSampleBoxes = 256;
+    static constexpr std::size_t kSwapEstimateFrom = 64;
+    struct SampledMove {
+        Box from, to;
+    };
+    std::vector<SampledMove> sampledMoves_;  ///< a uniform sample of the sampled moves
+    std::uint64_t moveSampleState_ = 0x9e3779b97f4a7c15u;  ///< the sample's fixed-seed generator
+    /// Endpoints a sorted sweep would pass per move, estimated from sampledMoves_ against
+    /// the sampled boxes' endpoints (fills SceneMeasure::swapsPerMove).
+    double estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots) const;
 };
 
 /// A btBroadphaseInterface over a kolize core. `Core` provides insert / update / remove,
