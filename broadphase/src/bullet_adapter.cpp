@@ -191,6 +191,7 @@ btBroadphaseProxy* BroadphaseAdapter::createProxy(const btVector3& aabbMin,
     fat_[slot] = boxes_[slot];
     travel_[slot] = 0;
     coreInsert(slot, fat_[slot]);
+    startShadow(slot);
     noteMoved(slot, kExactMoved | kCoreMoved);
     return proxy;
 }
@@ -395,6 +396,16 @@ void BroadphaseAdapter::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax
     }
     aabbMin.setValue(all.lo[0], all.lo[1], all.lo[2]);
     aabbMax.setValue(all.hi[0], all.hi[1], all.hi[2]);
+}
+
+void BroadphaseAdapter::startShadow(ObjectId slot) {
+    // The fat box the object would have if it rested, not its exact box: otherwise its first
+    // sampled move, however small, would count as leaving it (a jittering pyramid that took
+    // the sweep showed a third of its moves leaving in its first full window, and reached
+    // the grid only at frame 96).
+    if (coreTracksOverlaps_ && measuring_) {
+        fat_[slot] = enlargedBox(boxes_[slot], boxes_[slot]);
+    }
 }
 
 void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
@@ -988,6 +999,7 @@ void BroadphaseAdapter::finishCoreSwitch(bool tracking) {
     for (std::size_t slot = 0; slot < boxes_.size(); ++slot) {
         if (state_[slot] == SlotState::Live) {
             coreInsert(ObjectId(slot), fat_[slot]);
+            startShadow(ObjectId(slot));
             noteMoved(ObjectId(slot), kExactMoved | kCoreMoved);
         }
     }

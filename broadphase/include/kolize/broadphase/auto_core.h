@@ -18,8 +18,12 @@
 ///   cells and no empty ones (sweep tests every object per ray; measured on mixed-rays and
 ///   bench-raycast: spatial-hash's rays 1.08 and 0.62 ms, grid's 1.08 and 2.04, sweep's
 ///   3.09 and 3.48);
-/// - at rest (under half an object moved per frame, after the first evaluation): the
-///   present core, which costs nothing while no box changes;
+/// - at rest (under half an object moved per frame): the present core, which costs nothing
+///   while no box changes. Before the first decision that is no decision: a world that has
+///   not moved yet keeps the starting core, and auto looks again after every sampled frame
+///   (every 8) until something moves (offset-1e6's bodies rest for their first frames, until
+///   their speed reaches a float step; judged from those frames, it took the sweep, which
+///   then took 2-3x the grid's time for 96 frames);
 /// - resting jitter (objects move every frame but their fat boxes hold every move and no
 ///   pair starts or stops overlapping, as in a stack or pyramid that does not fall
 ///   asleep): grid, whose fat boxes and pair certificates absorb the moves, where the
@@ -45,12 +49,12 @@
 ///   (thesis B fast, 3000 objects: spatial-hash 0.25x of dbvt, segment-trees 0.32x, grid
 ///   1.4x, kolize-bench);
 /// - faster motion otherwise: grid.
-/// The first evaluation (after two pair searches) switches at once: the starting core
-/// (grid) was nobody's choice. After that a choice must win two evaluations in a row
-/// (every 32 frames), and every choice after the second stands at least 128 frames, so a
-/// scene on a threshold does not flip back and forth (the first, made from two frames, may
-/// be corrected as soon as a new choice has won twice: a pyramid that jitters is seen as
-/// such from its second window on).
+/// The first decision (after two pair searches, or later if nothing moved) switches at once:
+/// the starting core (grid) was nobody's choice. So does the first decision made from a full
+/// window (16 frames or more; the first is often made from two): a pyramid that jitters is
+/// seen as such from its first full window on. After that a choice must win two evaluations
+/// in a row (every 32 frames), and every choice after the second switch stands at least 128
+/// frames, so a scene on a threshold does not flip back and forth.
 
 #include <kolize/broadphase/aabb.h>
 #include <kolize/broadphase/cell_grid.h>
@@ -128,6 +132,9 @@ class AutoCore {
     }
 
     Kind kind() const { return kind_; }
+    /// True until an evaluation has seen motion (or sizes or rays that decide alone): the
+    /// adapter evaluates after every sampled frame meanwhile, not every evaluateEvery.
+    bool undecided() const { return evaluations_ == 0; }
     bool tracksOverlaps() const { return kind_ == Kind::Sweep; }
     /// Why the present core was chosen (for kolize-demo), and how many switches so far.
     const std::string& reason() const { return reason_; }
@@ -138,13 +145,25 @@ class AutoCore {
     Kind decide(const SceneMeasure& measure) {
         framesSinceSwitch_ += std::size_t(measure.frames);
         const Kind wanted = rule(measure);
+        if (waiting_) {
+            reason_ = ruleReason_;
+            return kind_;  // nothing moved yet: no evidence, no decision
+        }
         ++evaluations_;
+        // The first decision takes effect at once (even when it keeps the starting core), and
+        // so does the first made from a full window: the first, often from two frames, is a
+        // guess (dense-pile's first two frames look fast; its pile is slow from frame 32 on,
+        // where the sweep takes a fifth of the grid's time). Later ones must win twice in a
+        // row.
+        const bool fullWindow = measure.frames >= kFullWindow;
+        const bool atOnce = evaluations_ == 1 || (fullWindow && !fullWindowSeen_);
+        fullWindowSeen_ = fullWindowSeen_ || fullWindow;
         if (wanted == kind_) {
             pending_ = kind_;
             reason_ = ruleReason_;
             return kind_;
         }
-        if (wanted != pending_ && switches_ > 0) {
+        if (wanted != pending_ && !atOnce) {
             pending_ = wanted;  // must win once more
             return kind_;
         }
@@ -239,6 +258,8 @@ class AutoCore {
     /// most 0.054; falling boxes that pile up, 0.1-1.5).
     static constexpr double kManySwapsPairChanges = 0.1;
     static constexpr double kJitterWindow = 16;
+    /// A measure over at least this many frames is a full window (see decide()).
+    static constexpr double kFullWindow = 16;
     static constexpr double kJitterFatExits = 0.01;
     static constexpr double kJitterPairChanges = 0.002;
 
@@ -260,9 +281,17 @@ class AutoCore {
                           " box sizes long: the sparse cells walk rays through few cells";
             return Kind::SpatialHash;
         }
-        if (m.movedPerFrame < 0.5 && evaluations_ > 0) {
-            ruleReason_ = "at rest (" + shortNumber(m.movedPerFrame) +
-                          " objects moved per frame): the present core costs nothing";
+        waiting_ = false;
+        if (m.movedPerFrame < 0.5) {
+            // Before the first decision, a world that has not moved tells nothing about its
+            // motion (offset-1e6's bodies start moving when their speed first reaches a float
+            // step, after a few frames): the starting core stays and auto looks again after
+            // the next sampled frame.
+            waiting_ = evaluations_ == 0;
+            ruleReason_ = waiting_ ? "no motion yet: the start's core until something moves"
+                                   : "at rest (" + shortNumber(m.movedPerFrame) +
+                                         " objects moved per frame): the present core costs "
+                                         "nothing";
             return kind_;
         }
         if (m.frames >= kJitterWindow && m.movedPerFrame >= 0.5 &&
@@ -420,7 +449,9 @@ class AutoCore {
     Kind pending_ = Kind::Grid;
     std::string reason_ = "the start: no measure yet, the grid";
     std::string ruleReason_;
-    std::size_t evaluations_ = 0;
+    std::size_t evaluations_ = 0;  ///< evaluations that decided (saw motion, spread or rays)
+    bool waiting_ = false;         ///< the last rule found no motion before any decision
+    bool fullWindowSeen_ = false;  ///< a decision was made from a full window
     std::size_t framesSinceSwitch_ = 0;
     std::size_t switches_ = 0;
 };

@@ -383,6 +383,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// A sampled setAabb of `slot` to `to` (boxes_[slot] still the previous box): its motion
     /// and whether it left the object's fat box.
     void noteMotion(ObjectId slot, const Box& to);
+    /// While the core tracks overlaps: starts the shadow fat box of `slot`, just inserted
+    /// into the core with its exact box.
+    void startShadow(ObjectId slot);
     /// What was measured since the last call; resets the accumulators. O(sampled objects).
     SceneMeasure takeMeasure();
     /// Before the core is replaced: every pair tested (statuses current, the cache
@@ -391,6 +394,14 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     void prepareCoreSwitch(bool tracking, btDispatcher* dispatcher);
     /// After the core was emptied: inserts every live object again, sets the mode.
     void finishCoreSwitch(bool tracking);
+    /// Whether the pair search after `frame` completed searches is the one after the search
+    /// that counted a sampled frame (as the first evaluation, after two searches, is): the
+    /// measure then holds a new frame of motion.
+    static bool followsSampledFrame(std::size_t frame) { return frame % kMotionSampleEvery == 2; }
+    /// Whether a move, ray or box query was measured since the last measure.
+    bool measuredAny() const {
+        return measuredChanges_ > 0 || measuredRays_ > 0 || measuredQueries_ > 0;
+    }
 
   private:
     /// Motion is sampled in one frame of every kMotionSampleEvery (the frame after a search
@@ -548,7 +559,11 @@ class CoreBroadphase final : public BroadphaseAdapter {
         if constexpr (kAuto) {
             const std::size_t frame = stats().frames;
             const std::size_t every = std::size_t(std::max(1, coreSettings_.evaluateEvery));
-            if (frame == 0 || (frame != 2 && frame % every != 0)) {
+            // Undecided, it looks again after each sampled frame that saw a move, a ray or a
+            // query (a world at rest from the start pays only the regular evaluations).
+            const bool due = frame == 2 || frame % every == 0 ||
+                             (core_.undecided() && followsSampledFrame(frame) && measuredAny());
+            if (frame == 0 || !due) {
                 return;
             }
             const SceneMeasure measure = takeMeasure();
