@@ -32,14 +32,16 @@
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
 ///   most Bullet worlds, resting or settling) in which a sorted sweep would swap much: the
 ///   estimated endpoints passed per moved object (SceneMeasure::swapsPerMove, known under
-///   any core) at least 30 x (1 + half the grid's crowding), under 0.1 pair changes per
-///   move: grid. Float coordinates far from the origin (offset-1e6: 50-75 passed, the grid
-///   0.7x of the sweep's time) and boxes settling on a lattice of equal coordinates
-///   (pyramid, and bench-1000-stack's first frames) pass many equal endpoints that the
-///   grid's cells never order;
+///   any core; while the sweep runs, its own count replaces the estimate) at least 30 x (1 +
+///   half the grid's crowding), under 0.1 pair changes per move: grid. Float coordinates far from
+///   the origin (offset-1e6: 50-75 passed, the grid 0.7x of the sweep's time) and boxes settling on
+///   a lattice of equal coordinates (pyramid, and bench-1000-stack's first frames) pass many equal
+///   endpoints that the grid's cells never order;
 /// - slow motion otherwise: sweep. (mixed-terrain, mixed-plane and offset-1e4 favour the
-///   grid over their first 64-96 frames, with 43-103 passed; the two evaluations a switch
-///   needs come too late there, and over 300 frames the sweep wins.)
+///   grid over their first 96 frames, with 43-110 passed: counted under the sweep, that
+///   takes the grid at frame 32; the estimate there, from boxes that had fallen away from
+///   the sampled moves' places, was 18. They favour the sweep again from frame 96 on, which
+///   auto sees by frame 160.)
 /// - faster motion, and the dense grid would crowd (its cells, enlarged to fit its budget of
 ///   cells per object over the objects' bounds, would put more than 16 + 2x as many other
 ///   objects beside an object as the sparse cells do: a cluster in a large space, as the
@@ -142,8 +144,20 @@ class AutoCore {
 
     /// Given the scene's measure, the core it should use (the rules above, with the
     /// hysteresis); sets reason().
-    Kind decide(const SceneMeasure& measure) {
+    Kind decide(const SceneMeasure& measured) {
+        SceneMeasure measure = measured;
         framesSinceSwitch_ += std::size_t(measure.frames);
+        // While the sweep runs, its swaps are counted, not estimated: the estimate (sampled
+        // moves against the boxes at this evaluation) misses where a world moved away from
+        // the sampled moves (mixed-terrain's falling bodies: estimated 18 per move at frame
+        // 32, counted 49 in the sampled frames).
+        swapsCounted_ = kind_ == Kind::Sweep && updates_ > updatesSeen_;
+        if (swapsCounted_) {
+            measure.swapsPerMove =
+                double(sweep_.swaps() - swapsSeen_) / double(updates_ - updatesSeen_);
+        }
+        swapsSeen_ = sweep_.swaps();
+        updatesSeen_ = updates_;
         const Kind wanted = rule(measure);
         if (waiting_) {
             reason_ = ruleReason_;
@@ -180,6 +194,8 @@ class AutoCore {
         hash_ = SpatialHash<D, Scalar>(settings_.cells);
         trees_ = SegmentTreeSet<D, Scalar>(noKeptSet(settings_.segmentTrees));
         sweep_ = SweepAndPrune<D, Scalar>();
+        swapsSeen_ = 0;
+        updatesSeen_ = updates_;
         kind_ = kind;
         pending_ = kind;
         reason_ = why;
@@ -195,6 +211,7 @@ class AutoCore {
         dispatch([&](auto& core) { core.insert(id, box); });
     }
     void update(ObjectId id, const Box& box) {
+        ++updates_;
         dispatch([&](auto& core) { core.update(id, box); });
     }
     void remove(ObjectId id) {
@@ -308,9 +325,11 @@ class AutoCore {
                                        " objects moved per frame, by " +
                                        shortNumber(m.relativeMotion) + " of their size)";
             const double crowd = crowding(m, denseCell(m, sparseCell(m)));
-            const std::string swaps = shortNumber(m.swapsPerMove) +
-                                      " endpoints passed per moved object; " + shortNumber(crowd) +
-                                      " others in an object's grid cell";
+            const std::string swaps =
+                shortNumber(m.swapsPerMove) +
+                (swapsCounted_ ? " endpoints passed per moved object (counted); "
+                               : " endpoints passed per moved object; ") +
+                shortNumber(crowd) + " others in an object's grid cell";
             // The first evaluation's pair changes are the world's first pairs, not motion.
             const double pairChanges = evaluations_ > 0 ? m.pairChangesPerMove : 0;
             if (m.swapsPerMove >= kManySwaps * (1 + crowd / 2) &&
@@ -452,6 +471,10 @@ class AutoCore {
     std::size_t evaluations_ = 0;  ///< evaluations that decided (saw motion, spread or rays)
     bool waiting_ = false;         ///< the last rule found no motion before any decision
     bool fullWindowSeen_ = false;  ///< a decision was made from a full window
+    /// Core updates so far; at the last evaluation, those and the sweep's swaps; whether the
+    /// last evaluation counted the swaps (the sweep ran) instead of taking the estimate.
+    std::size_t updates_ = 0, updatesSeen_ = 0, swapsSeen_ = 0;
+    bool swapsCounted_ = false;
     std::size_t framesSinceSwitch_ = 0;
     std::size_t switches_ = 0;
 };
