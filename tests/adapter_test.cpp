@@ -905,6 +905,22 @@ double passedInDescription(const std::string& description) {
     return std::stod(description.substr(start + 1, at - start - 1));
 }
 
+/// Unit boxes with x-lows xs[i] and y and z on a lattice 1.5 apart, 20 to a row (no two
+/// overlap, whatever their x): created in `broadphase` and recorded in `boxes`.
+std::vector<btBroadphaseProxy*> unitBoxRows(btBroadphaseInterface& broadphase, BoxMap& boxes,
+                                            const std::vector<btScalar>& xs) {
+    static char client;
+    std::vector<btBroadphaseProxy*> proxies;
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+        const btVector3 lo(xs[i], btScalar(1.5 * double(i % 20)), btScalar(1.5 * double(i / 20)));
+        ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
+        box.proxy = broadphase.createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
+        proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
+        boxes[box.proxy] = box;
+    }
+    return proxies;
+}
+
 // Slow motion (a tenth of a box per frame) in which every move passes many endpoints: the
 // boxes' x-intervals start at one of two values, so a box that changes value passes about
 // half of each value's ties. The sweep would swap hundreds of endpoints per move; "auto"
@@ -919,20 +935,12 @@ TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
         auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
         std::mt19937 random(7);
         std::bernoulli_distribution flip(0.5);
-        std::vector<btBroadphaseProxy*> proxies;
         std::vector<btScalar> base;
-        BoxMap boxes;
-        static char client;
         for (int i = 0; i < 400; ++i) {
-            // y and z on a lattice 1.5 apart (unit boxes: no two overlap, no pair ever).
             base.push_back(tied ? btScalar(0) : btScalar(3 * i));
-            const btVector3 lo(base.back(), btScalar(1.5 * (i % 20)), btScalar(1.5 * (i / 20)));
-            ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
-            box.proxy =
-                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
-            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
-            boxes[box.proxy] = box;
         }
+        BoxMap boxes;
+        const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
         double counted = 0, moves = 0;
         for (int frame = 0; frame < 100; ++frame) {
             // A plain count: endpoints of the other boxes (as the frame starts) between
@@ -997,19 +1005,12 @@ TEST(Auto, AWorldThatStartsStillIsJudgedByItsFirstMotion) {
         auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
         std::mt19937 random(21);
         std::bernoulli_distribution flip(0.5);
-        std::vector<btBroadphaseProxy*> proxies;
         std::vector<btScalar> base;
-        BoxMap boxes;
-        static char client;
         for (int i = 0; i < 400; ++i) {
             base.push_back(tied ? btScalar(0) : btScalar(3 * i));
-            const btVector3 lo(base.back(), btScalar(1.5 * (i % 20)), btScalar(1.5 * (i / 20)));
-            ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
-            box.proxy =
-                broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
-            proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
-            boxes[box.proxy] = box;
         }
+        BoxMap boxes;
+        const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
         constexpr int kStill = 21, kDecided = kStill + 9;
         for (int frame = 0; frame < kDecided; ++frame) {
             const bool moving = frame >= kStill;
@@ -1096,18 +1097,12 @@ TEST(Auto, TheSweepsOwnSwapsDecideWhileItRuns) {
     auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
     std::mt19937 random(11);
     std::uniform_real_distribution<double> band(0, 0.5), jitter(-1e-5, 1e-5);
-    std::vector<btBroadphaseProxy*> proxies;
-    BoxMap boxes;
-    static char client;
+    std::vector<btScalar> xs;
     for (int i = 0; i < 400; ++i) {
-        // y and z on a lattice 1.5 apart: unit boxes never overlap.
-        const btVector3 lo(btScalar(band(random)), btScalar(1.5 * (i % 20)),
-                           btScalar(1.5 * (i / 20)));
-        ProxyBox box{nullptr, lo, lo + btVector3(1, 1, 1)};
-        box.proxy = broadphase->createProxy(box.aabbMin, box.aabbMax, 0, &client, 1, -1, nullptr);
-        proxies.push_back(const_cast<btBroadphaseProxy*>(box.proxy));
-        boxes[box.proxy] = box;
+        xs.push_back(btScalar(band(random)));
     }
+    BoxMap boxes;
+    const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, xs);
     for (int frame = 0; frame < 40; ++frame) {
         for (btBroadphaseProxy* proxy : proxies) {
             ProxyBox& box = boxes[proxy];
