@@ -905,6 +905,15 @@ double passedInDescription(const std::string& description) {
     return std::stod(description.substr(start + 1, at - start - 1));
 }
 
+/// The x-lows of 400 unit boxes: all 0 (tied) or 3 apart (spread: no two x-intervals meet).
+std::vector<btScalar> tiedOrSpread(bool tied) {
+    std::vector<btScalar> xs;
+    for (int i = 0; i < 400; ++i) {
+        xs.push_back(tied ? btScalar(0) : btScalar(3 * i));
+    }
+    return xs;
+}
+
 /// Unit boxes with x-lows xs[i] and y and z on a lattice 1.5 apart, 20 to a row (no two
 /// overlap, whatever their x): created in `broadphase` and recorded in `boxes`.
 std::vector<btBroadphaseProxy*> unitBoxRows(btBroadphaseInterface& broadphase, BoxMap& boxes,
@@ -935,10 +944,7 @@ TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
         auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
         std::mt19937 random(7);
         std::bernoulli_distribution flip(0.5);
-        std::vector<btScalar> base;
-        for (int i = 0; i < 400; ++i) {
-            base.push_back(tied ? btScalar(0) : btScalar(3 * i));
-        }
+        const std::vector<btScalar> base = tiedOrSpread(tied);
         BoxMap boxes;
         const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
         double counted = 0, moves = 0;
@@ -1005,10 +1011,7 @@ TEST(Auto, AWorldThatStartsStillIsJudgedByItsFirstMotion) {
         auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
         std::mt19937 random(21);
         std::bernoulli_distribution flip(0.5);
-        std::vector<btScalar> base;
-        for (int i = 0; i < 400; ++i) {
-            base.push_back(tied ? btScalar(0) : btScalar(3 * i));
-        }
+        const std::vector<btScalar> base = tiedOrSpread(tied);
         BoxMap boxes;
         const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
         constexpr int kStill = 21, kDecided = kStill + 9;
