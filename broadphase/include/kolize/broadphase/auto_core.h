@@ -9,6 +9,8 @@
 /// freed).
 ///
 /// The rules (measured with kolize-demo over the scene registry, see README):
+/// - under 64 objects: sweep, whatever they do (the registry's small worlds, 5-40 bodies,
+///   cost it 0.0006-0.003 ms per frame, the other cores up to 6x that);
 /// - sizes spread over more than 30x (90th over 10th percentile): segment-trees, whose cost
 ///   does not depend on one cell size or on endpoints of small boxes passing large ones
 ///   (mixed-sizes, replayed: segment-trees 0.47x of sap-noray, sweep 1.8x, spatial-hash
@@ -42,7 +44,10 @@
 ///   takes the grid at frame 32; the estimate there, from boxes that had fallen away from
 ///   the sampled moves' places, was 18. They favour the sweep again from frame 96 on, which
 ///   auto sees by frame 160.)
-/// - faster motion, and the dense grid would crowd (its cells, enlarged to fit its budget of
+/// - faster motion in which a moved box passes under 4 endpoints (bodies flying apart, or
+///   falling together): sweep, whose cost does not grow with the distance a box goes;
+/// - faster motion otherwise, and the dense grid would crowd (its cells, enlarged to fit its budget
+/// of
 ///   cells per object over the objects' bounds, would put more than 16 + 2x as many other
 ///   objects beside an object as the sparse cells do: a cluster in a large space, as the
 ///   thesis's scene B with 33 at 300 objects and 340 at 3000; escape's 300 bodies flying
@@ -274,6 +279,17 @@ class AutoCore {
     /// look where the sweep has found it already (the windows where the grid won had at
     /// most 0.054; falling boxes that pile up, 0.1-1.5).
     static constexpr double kManySwapsPairChanges = 0.1;
+    /// Fast motion in which a moved box passes under this many endpoints: the sweep. A fast
+    /// move costs the sweep about 30 ns + 12 ns per endpoint passed (far jumps), the grid
+    /// 70-100 ns (replayed, per moved object): escape's bodies flying apart pass 1-4 from
+    /// frame 64 on (the sweep 0.45-0.7x of the grid's time), thesis A's fast cubes 12 (the
+    /// grid 0.4x of the sweep's), dense-pile's first frames, falling in lockstep, none.
+    static constexpr double kFewSwapsFast = 4;
+    /// Under this many objects (not planes: all live boxes) the sweep (registry, replayed:
+    /// tall-stack's 40 bodies, mass-ratio-stack's 20 and the mesh worlds' 5-24 cost the
+    /// sweep 0.0006-0.003 ms, the other cores up to 6x that: mesh-wall's 9 boxes, a 40 m
+    /// wall among 0.5 m bodies, took the segment trees for their spread of sizes).
+    static constexpr std::size_t kFewObjects = 64;
     static constexpr double kJitterWindow = 16;
     /// A measure over at least this many frames is a full window (see decide()).
     static constexpr double kFullWindow = 16;
@@ -287,6 +303,12 @@ class AutoCore {
 
     Kind rule(const SceneMeasure& m) {
         const double n = double(m.objects);
+        waiting_ = false;
+        if (m.objects < kFewObjects) {
+            ruleReason_ = std::to_string(m.objects) +
+                          " objects: a sweep over so few costs least, whatever they do";
+            return Kind::Sweep;
+        }
         if (m.sizeSpread > 30) {
             ruleReason_ = "sizes spread " + shortNumber(m.sizeSpread) +
                           "x: segment trees do not depend on one cell size";
@@ -298,7 +320,6 @@ class AutoCore {
                           " box sizes long: the sparse cells walk rays through few cells";
             return Kind::SpatialHash;
         }
-        waiting_ = false;
         if (m.movedPerFrame < 0.5) {
             // Before the first decision, a world that has not moved tells nothing about its
             // motion (offset-1e6's bodies start moving when their speed first reaches a float
@@ -340,6 +361,14 @@ class AutoCore {
             }
             ruleReason_ = motion + ": sorted endpoints move few places (" + swaps + "; " +
                           shortNumber(m.pairChangesPerMove) + " pair changes per move)";
+            return Kind::Sweep;
+        }
+        if (m.swapsPerMove < kFewSwapsFast) {
+            ruleReason_ = "fast motion (" + shortNumber(m.relativeMotion) +
+                          " of their size per frame), but sorted endpoints move few places (" +
+                          shortNumber(m.swapsPerMove) + " endpoints passed per moved object" +
+                          (swapsCounted_ ? ", counted" : "") +
+                          "): the sweep does not care how far a box goes";
             return Kind::Sweep;
         }
         const double sparse = sparseCell(m), dense = denseCell(m, sparse);
