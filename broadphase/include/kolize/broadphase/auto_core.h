@@ -34,11 +34,12 @@
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
 ///   most Bullet worlds, resting or settling) in which a sorted sweep would swap much: the
 ///   estimated endpoints passed per moved object (SceneMeasure::swapsPerMove, known under
-///   any core; while the sweep runs, its own count replaces the estimate) at least 30 x (1 +
-///   half the grid's crowding), under 0.1 pair changes per move: grid. Float coordinates far from
-///   the origin (offset-1e6: 50-75 passed, the grid 0.7x of the sweep's time) and boxes settling on
-///   a lattice of equal coordinates (pyramid, and bench-1000-stack's first frames) pass many equal
-///   endpoints that the grid's cells never order;
+///   any core; while the sweep runs, its own count replaces the estimate) at least
+///   30 x (1 + half the grid's crowding), under 0.1 pair changes per move: grid. Float
+///   coordinates far from the origin (offset-1e6: 50-75 passed, the grid 0.7x of the
+///   sweep's time) and boxes settling on a lattice of equal coordinates (pyramid, and
+///   bench-1000-stack's first frames) pass many equal endpoints that the grid's cells never
+///   order;
 /// - slow motion otherwise: sweep. (mixed-terrain, mixed-plane and offset-1e4 favour the
 ///   grid over their first 96 frames, with 43-110 passed: counted under the sweep, that
 ///   takes the grid at frame 32; the estimate there, from boxes that had fallen away from
@@ -46,10 +47,9 @@
 ///   auto sees by frame 160.)
 /// - faster motion in which a moved box passes under 4 endpoints (bodies flying apart, or
 ///   falling together): sweep, whose cost does not grow with the distance a box goes;
-/// - faster motion otherwise, and the dense grid would crowd (its cells, enlarged to fit its budget
-/// of
-///   cells per object over the objects' bounds, would put more than 16 + 2x as many other
-///   objects beside an object as the sparse cells do: a cluster in a large space, as the
+/// - faster motion otherwise, and the dense grid would crowd (its cells, enlarged to fit its
+///   budget of cells per object over the objects' bounds, would put more than 16 + 2x as
+///   many other objects beside an object as the sparse cells do: a cluster in a large space, as the
 ///   thesis's scene B with 33 at 300 objects and 340 at 3000; escape's 300 bodies flying
 ///   apart have 14, where grid takes a quarter of spatial-hash's time): spatial-hash,
 ///   whose cells keep their size wherever the objects are
