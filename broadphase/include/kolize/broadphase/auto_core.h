@@ -149,8 +149,7 @@ class AutoCore {
 
     /// Given the scene's measure, the core it should use (the rules above, with the
     /// hysteresis); sets reason().
-    Kind decide(const SceneMeasure& measured) {
-        SceneMeasure measure = measured;
+    Kind decide(SceneMeasure measure) {
         framesSinceSwitch_ += std::size_t(measure.frames);
         // While the sweep runs, its swaps are counted, not estimated: the estimate (sampled
         // moves against the boxes at this evaluation) misses where a world moved away from

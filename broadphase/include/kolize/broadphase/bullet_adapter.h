@@ -566,8 +566,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
             if (frame == 0 || !due) {
                 return;
             }
-            const SceneMeasure measure = takeMeasure();
-            const typename Core::Kind wanted = core_.decide(measure);
+            const typename Core::Kind wanted = core_.decide(takeMeasure());
             if (wanted == core_.kind()) {
                 return;
             }
