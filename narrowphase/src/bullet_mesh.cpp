@@ -124,12 +124,15 @@ struct Candidate {
     Vec3 point;
     int patch;
     TrianglePair ids;
+    double depth;
 };
 
 struct Patch {
     Vec3 normal = Vec3::Zero();
     double depth = 0;
     bool valid = false;
+    /// Its vertices inside the other mesh (s.inside) span an area: they are its points.
+    bool byVertices = false;
 };
 
 int findRoot(std::vector<int>& parent, int i) {
@@ -201,6 +204,8 @@ struct ContactScratch {
     std::vector<Vec3> pointsA, pointsB;
     std::vector<std::pair<double, Vec3>> normals;
     std::vector<Candidate> candidates;
+    std::vector<Candidate> inside;          // vertices inside the other mesh, all patches
+    std::vector<int> insideOfA, insideOfB;  // a vertex's entry in `inside`, -1 between calls
     std::vector<const PairContact*> sorted;
     std::vector<const NearPair*> sortedNear;
 };
@@ -237,6 +242,89 @@ Vec3 outward(const Vec3& n, Sides sides, const TriangleMesh& mesh, const Index3&
 
 void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
                     const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s);
+
+/// How far `v` lies inside a mesh below its triangle (q0, q1, q2) with outward unit normal
+/// `m`, measured along -d (d unit, the direction the mesh moves out): t >= 0 with v - t d in
+/// the closed triangle and v behind or on its plane; -1 when v is in front, the line along d
+/// runs within 1e-3 of the plane's direction, or passes beside the triangle.
+double depthBelow(const Vec3& v, const Vec3& d, const Vec3& q0, const Vec3& q1, const Vec3& q2,
+                  const Vec3& m) {
+    const double behind = (v - q0).dot(m);
+    const double along = d.dot(m);
+    if (behind > 0 || along > -1e-3) {
+        return -1;
+    }
+    const double t = behind / along;
+    const Vec3 p = v - t * d;
+    const Vec3* q[3] = {&q0, &q1, &q2};
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 edge = *q[(k + 1) % 3] - *q[k];
+        // Within a relative hair of an edge counts as on it (the point's rounding).
+        if (edge.cross(p - *q[k]).dot(m) <
+            -1e-12 * (edge.squaredNorm() + (p - *q[k]).squaredNorm())) {
+            return -1;
+        }
+    }
+    return t;
+}
+
+/// Whether the points of candidates[first..] span an area: not all within 1e-9 of their
+/// extent of the line through the first and the farthest from it.
+bool spansArea(const std::vector<Candidate>& candidates, std::size_t first) {
+    if (candidates.size() < first + 3) {
+        return false;
+    }
+    const Vec3& p0 = candidates[first].point;
+    std::size_t far = first;
+    for (std::size_t k = first + 1; k < candidates.size(); ++k) {
+        if ((candidates[k].point - p0).squaredNorm() > (candidates[far].point - p0).squaredNorm()) {
+            far = k;
+        }
+    }
+    const Vec3 axis = candidates[far].point - p0;
+    const double length2 = axis.squaredNorm();
+    for (std::size_t k = first + 1; k < candidates.size(); ++k) {
+        if (axis.cross(candidates[k].point - p0).squaredNorm() > 1e-18 * length2 * length2) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/// Adds the vertices of the pair `c` that lie inside the other mesh below the pair's other
+/// triangle (depthBelow along the patch normal n, from A towards B) to s.inside, one entry
+/// per vertex at its least depth; `bInA` moves B's vertices into A's frame.
+void insideVertices(const PairContact& c, int patch, const Vec3& n, const Vec3& normalA,
+                    const Vec3& normalB, const TriangleMesh& meshA, const TriangleMesh& meshB,
+                    const RelativePose& bInA, ContactScratch& s) {
+    const Index3& ia = meshA.triangles()[c.pair.a];
+    const Index3& ib = meshB.triangles()[c.pair.b];
+    const std::array<Vec3, 3> a = {meshA.vertices()[ia[0]], meshA.vertices()[ia[1]],
+                                   meshA.vertices()[ia[2]]};
+    const std::array<Vec3, 3> b = {bInA.apply(meshB.vertices()[ib[0]]),
+                                   bInA.apply(meshB.vertices()[ib[1]]),
+                                   bInA.apply(meshB.vertices()[ib[2]])};
+    auto keep = [&](int& slot, const Vec3& point, double depth) {
+        if (depth < 0) {
+            return;
+        }
+        if (slot < 0) {
+            slot = int(s.inside.size());
+            s.inside.push_back({point, patch, c.pair, depth});
+        } else if (depth < s.inside[slot].depth) {
+            s.inside[slot] = {point, patch, c.pair, depth};
+        }
+    };
+    // A moves out of B along -n: A's vertex v meets B's face at v - t n; the contact point
+    // is halfway, v - (t/2) n. B moves out along +n.
+    for (int k = 0; k < 3; ++k) {
+        const double t = depthBelow(a[k], n, b[0], b[1], b[2], normalB);
+        keep(s.insideOfA[ia[k]], a[k] - (0.5 * t) * n, t);
+        const double u = depthBelow(b[k], -n, a[0], a[1], a[2], normalA);
+        keep(s.insideOfB[ib[k]], b[k] + (0.5 * u) * n, u);
+    }
+}
+
 void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out);
 
 /// Up to 4 contacts (in A's frame, X = A) from the query's pairs. `bInA` is the pose the
@@ -250,6 +338,7 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
     out.clear();
     const std::size_t count = result.contacts.size();
     s.patches.assign(count, Patch{});
+    s.inside.clear();
     if (count > 0) {
         patchesOfPairs(result, meshA, meshB, bInA, sidesA, sidesB, s);
     }
@@ -272,21 +361,30 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
         }
         s.patches.push_back(patch);
     }
+    // A patch's points: its vertices inside the other mesh, each at its own depth, where
+    // they span an area; otherwise the intersection curve's points at the patch's depth.
     s.candidates.clear();
+    for (const Candidate& c : s.inside) {
+        if (s.patches[c.patch].byVertices) {
+            s.candidates.push_back(c);
+        }
+    }
     for (std::size_t i = 0; i < count; ++i) {
         const int root = s.root[i];
-        if (!s.patches[root].valid) {
+        const Patch& patch = s.patches[root];
+        if (!patch.valid || patch.byVertices) {
             continue;
         }
         const TriangleIntersection& g = s.sorted[i]->geometry;
         for (int k = 0; k < g.count; ++k) {
-            s.candidates.push_back({g.points[k], root, s.sorted[i]->pair});
+            s.candidates.push_back({g.points[k], root, s.sorted[i]->pair, patch.depth});
         }
     }
     for (std::size_t j = 0; j < near.size(); ++j) {
-        if (s.patches[count + j].valid) {
-            s.candidates.push_back(
-                {0.5 * (near[j]->on_a + near[j]->on_b), int(count + j), near[j]->pair});
+        const Patch& patch = s.patches[count + j];
+        if (patch.valid) {
+            s.candidates.push_back({0.5 * (near[j]->on_a + near[j]->on_b), int(count + j),
+                                    near[j]->pair, patch.depth});
         }
     }
     if (s.candidates.empty()) {
@@ -323,6 +421,12 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
     }
     if (s.normalOfB.size() < meshB.triangleCount()) {
         s.normalOfB.resize(meshB.triangleCount(), -1);
+    }
+    if (s.insideOfA.size() < meshA.vertices().size()) {
+        s.insideOfA.resize(meshA.vertices().size(), -1);
+    }
+    if (s.insideOfB.size() < meshB.vertices().size()) {
+        s.insideOfB.resize(meshB.vertices().size(), -1);
     }
     unionByVertex(
         count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i]->pair.a][k]; },
@@ -467,6 +571,33 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
         }
         patch.valid = std::isfinite(best);
         patch.depth = patch.valid ? std::max(best, 0.0) : 0.0;
+        // Inside has a meaning where both meshes are closed (or scenery, two-sided, whose
+        // outside faces the mesh body): an open mesh's outward normals are a guess (the
+        // wall's and the pile's open models went 2-10 cm deep on vertex points so placed).
+        if (patch.valid && sidesA != Sides::kOpen && sidesB != Sides::kOpen) {
+            const std::size_t first = s.inside.size();
+            for (std::size_t k = begin; k < end; ++k) {
+                const PairContact& c = *pairs[s.order[k]];
+                insideVertices(c, root, patch.normal,
+                               outward(c.normal_a, sidesA, meshA, meshA.triangles()[c.pair.a],
+                                       nullptr, Vec3::Zero()),
+                               outward(c.normal_b, sidesB, meshB, meshB.triangles()[c.pair.b],
+                                       &bInA, bInA.apply(Vec3::Zero())),
+                               meshA, meshB, bInA, s);
+            }
+            for (std::size_t k = begin; k < end; ++k) {
+                const PairContact& c = *pairs[s.order[k]];
+                for (int j = 0; j < 3; ++j) {
+                    s.insideOfA[meshA.triangles()[c.pair.a][j]] = -1;
+                    s.insideOfB[meshB.triangles()[c.pair.b][j]] = -1;
+                }
+            }
+            for (std::size_t k = first; k < s.inside.size(); ++k) {
+                // At most the patch's depth (so by construction; this guards the rounding).
+                s.inside[k].depth = std::min(s.inside[k].depth, patch.depth);
+            }
+            patch.byVertices = spansArea(s.inside, first);
+        }
         begin = end;
     }
 }
@@ -480,8 +611,7 @@ void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
     {
         int best = 0;
         for (int i = 1; i < int(s.candidates.size()); ++i) {
-            if (s.patches[s.candidates[i].patch].depth >
-                s.patches[s.candidates[best].patch].depth) {
+            if (s.candidates[i].depth > s.candidates[best].depth) {
                 best = i;
             }
         }
@@ -538,7 +668,7 @@ void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
         MeshContact contact;
         contact.point = c.point;
         contact.normal = patch.normal;
-        contact.depth = patch.depth;
+        contact.depth = c.depth;
         contact.triangleX = c.ids.a;
         contact.triangleY = c.ids.b;
         out.push_back(contact);

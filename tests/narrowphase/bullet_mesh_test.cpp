@@ -489,6 +489,59 @@ double surfaceDistance(const btTransform& t, const Vec3& h, const Vec3& p) {
     return (q.cwiseAbs() - h).maxCoeff();
 }
 
+/// How far p (inside the box of half extents h at t, or on it) moves along the unit `dir`
+/// until it leaves the box: the slabs' nearest exit, in the box's frame.
+double exitDistance(const btTransform& t, const Vec3& h, const Vec3& p, const Vec3& dir) {
+    const Vec3 q = toVec3(t.invXform(btVector3(btScalar(p.x()), btScalar(p.y()), btScalar(p.z()))));
+    const Vec3 e = toVec3(t.getBasis().transpose() *
+                          btVector3(btScalar(dir.x()), btScalar(dir.y()), btScalar(dir.z())));
+    double exit = 1e300;
+    for (int k = 0; k < 3; ++k) {
+        if (e[k] != 0) {
+            exit = std::min(exit, ((e[k] > 0 ? h[k] : -h[k]) - q[k]) / e[k]);
+        }
+    }
+    return exit;
+}
+
+/// The distance from p to the nearest of `vertices`.
+double nearestVertex(const std::vector<Vec3>& vertices, const Vec3& p) {
+    double best = 1e300;
+    for (const Vec3& v : vertices) {
+        best = std::min(best, (v - p).norm());
+    }
+    return best;
+}
+
+/// Checks a contact of box X (pose tx, half extents hx) against box Y, normal from X to Y:
+/// either a point of the intersection curve (on both surfaces) at the exact overlap along the
+/// normal, or a vertex of one box inside the other: then its ends (point -+ normal * depth/2)
+/// are that vertex and the place where it leaves the other box along the normal, at that
+/// distance (exitDistance, computed here from the boxes alone). Returns true for a vertex.
+bool checkBoxContact(const kolize::MeshContact& c, const btTransform& tx, const Vec3& hx,
+                     const btTransform& ty, const Vec3& hy, double overlap,
+                     const std::string& where) {
+    EXPECT_GE(c.depth, 0) << where;
+    EXPECT_LE(c.depth, overlap + 1e-6) << where;
+    const Vec3 onX = c.point + 0.5 * c.depth * c.normal;  // X's end: inside Y
+    const Vec3 onY = c.point - 0.5 * c.depth * c.normal;
+    const bool xVertex = nearestVertex(boxVertices(tx, hx), onX) < 1e-5;
+    const bool yVertex = nearestVertex(boxVertices(ty, hy), onY) < 1e-5;
+    if (std::abs(c.depth - overlap) <= 1e-6 && std::abs(surfaceDistance(tx, hx, c.point)) < 1e-5 &&
+        std::abs(surfaceDistance(ty, hy, c.point)) < 1e-5) {
+        return false;  // on the intersection curve
+    }
+    EXPECT_TRUE(xVertex || yVertex) << where << ": neither on the curve nor at a vertex";
+    if (xVertex) {
+        EXPECT_LT(surfaceDistance(ty, hy, onX), 1e-5) << where << ": X's vertex outside Y";
+        EXPECT_NEAR(exitDistance(ty, hy, onX, -c.normal), c.depth, 1e-5) << where;
+    } else if (yVertex) {
+        EXPECT_LT(surfaceDistance(tx, hx, onY), 1e-5) << where << ": Y's vertex outside X";
+        EXPECT_NEAR(exitDistance(tx, hx, onY, c.normal), c.depth, 1e-5) << where;
+    }
+    return true;
+}
+
 /// How far the vertex sets overlap along d (from `lower` towards `upper`).
 double overlapAlong(const std::vector<Vec3>& lower, const std::vector<Vec3>& upper, const Vec3& d) {
     double highest = -1e300, lowest = 1e300;
@@ -508,6 +561,7 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
     const Vec3 halves[4] = {Vec3(5, 5, 0.5), Vec3::Constant(Stack::kHalf[0]),
                             Vec3::Constant(Stack::kHalf[1]), Vec3::Constant(Stack::kHalf[2])};
     int checkedFrames[3] = {0, 0, 0};
+    int vertexPoints = 0;
     for (int step = 0; step < 300; ++step) {
         // The contacts of a step are made at the poses the previous step ended with.
         btTransform poses[4];
@@ -549,13 +603,15 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
             const double exactDepth = overlapAlong(lowerVertices, upperVertices, up);
             EXPECT_GT(exactDepth, 0);
             EXPECT_LT(exactDepth, 0.02);
-            // Every point is on the intersection curve: on both boxes' surfaces.
+            // Every point is on the intersection curve at the exact overlap, or a vertex of one
+            // box inside the other at the distance it leaves that box along the normal.
+            const int x = lowerFirst ? i : i + 1, y = lowerFirst ? i + 1 : i;
             for (std::size_t k = 0; k < contacts.size(); ++k) {
                 const kolize::MeshContact& c = contacts[k];
                 EXPECT_LT((c.normal - contacts[0].normal).norm(), 1e-12) << "one patch";
-                EXPECT_NEAR(c.depth, exactDepth, 1e-6) << "level " << i;
-                EXPECT_LT(std::abs(surfaceDistance(poses[i], halves[i], c.point)), 1e-5);
-                EXPECT_LT(std::abs(surfaceDistance(poses[i + 1], halves[i + 1], c.point)), 1e-5);
+                vertexPoints +=
+                    checkBoxContact(c, poses[x], halves[x], poses[y], halves[y], exactDepth,
+                                    "level " + std::to_string(i) + " step " + std::to_string(step));
                 for (std::size_t j = 0; j < k; ++j) {
                     EXPECT_GT((contacts[j].point - c.point).norm(), 1e-12) << "repeated point";
                 }
@@ -578,6 +634,7 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
         // touching, and an exact test finds nothing new.
         EXPECT_GE(checkedFrames[i], 10) << "level " << i << ": too few frames with contacts";
     }
+    EXPECT_GE(vertexPoints, 20) << "too few vertex points: that kind went unchecked";
     double restTop = 0;
     for (int i = 0; i < 3; ++i) {
         const btRigidBody* body = stack.boxes[i];
@@ -658,6 +715,7 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
     Floor scene(w);
     double lowest[2] = {1e9, 1e9};
     int checkedFrames[2] = {0, 0};
+    int vertexPoints = 0;
     for (int step = 0; step < 300; ++step) {
         btTransform poses[2] = {scene.boxes[0]->getWorldTransform(),
                                 scene.boxes[1]->getWorldTransform()};
@@ -682,6 +740,36 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
             for (const kolize::MeshContact& c : contacts) {
                 // X is the mesh: the normal points from it down into the floor, exactly.
                 EXPECT_LT((c.normal - Vec3(0, 0, -1)).norm(), 1e-12) << "box " << b;
+                EXPECT_GE(c.triangleY, 0);
+                EXPECT_LT(c.triangleY, 200);
+                EXPECT_EQ(c.partY, 0);
+                // Not on the intersection curve at the exact depth: a vertex of the box under
+                // the floor, or a floor vertex inside the box. The floor's end is on the
+                // floor, the box's on the box, the depth the vertex's distance to the other
+                // along the normal.
+                if (std::abs(c.point.z()) > 1e-6 || std::abs(c.depth - exactDepth) > 1e-6) {
+                    ++vertexPoints;
+                    const Vec3 onBox = c.point + 0.5 * c.depth * c.normal;
+                    const Vec3 onFloor = c.point - 0.5 * c.depth * c.normal;
+                    const bool boxVertex = nearestVertex(vertices, onBox) < 1e-5;
+                    const bool floorVertex =
+                        std::abs(onFloor.x() - std::round(onFloor.x())) < 1e-6 &&
+                        std::abs(onFloor.y() - std::round(onFloor.y())) < 1e-6;
+                    EXPECT_TRUE(boxVertex || floorVertex) << "box " << b << " step " << step;
+                    EXPECT_NEAR(onFloor.z(), 0, 1e-6) << "box " << b;
+                    EXPECT_LT(std::abs(surfaceDistance(poses[b], Vec3::Constant(0.5), onBox)), 1e-5)
+                        << "box " << b;
+                    EXPECT_LE(c.depth, exactDepth + 1e-6) << "box " << b;
+                    if (boxVertex) {
+                        EXPECT_NEAR(c.depth, -onBox.z(), 1e-6) << "box " << b;
+                    } else if (floorVertex) {
+                        EXPECT_NEAR(exitDistance(poses[b], Vec3::Constant(0.5), onFloor, c.normal),
+                                    c.depth, 1e-5)
+                            << "box " << b;
+                    }
+                    continue;
+                }
+                // Otherwise on the intersection curve, at the exact depth.
                 EXPECT_NEAR(c.point.z(), 0, 1e-6);
                 // On the box: within its faces, in its own frame (a disk of the half diagonal
                 // around the centre, the check this replaces, is too small by half the
@@ -692,10 +780,6 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
                 for (int k = 0; k < 3; ++k) {
                     EXPECT_LE(std::fabs(local[k]), 0.5 + 1e-5) << "box " << b;
                 }
-                EXPECT_NEAR(c.depth, exactDepth, 1e-6) << "box " << b;
-                EXPECT_GE(c.triangleY, 0);
-                EXPECT_LT(c.triangleY, 200);
-                EXPECT_EQ(c.partY, 0);
             }
         }
     }
@@ -703,6 +787,7 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
         btRigidBody* box = scene.boxes[b];
         const btTransform& t = box->getWorldTransform();
         EXPECT_GE(checkedFrames[b], 8) << "box " << b << ": too few frames with contacts";
+        EXPECT_GE(vertexPoints, 8) << "too few vertex points: that kind went unchecked";
         EXPECT_GT(lowest[b], 0.47) << "box " << b << " sank";  // no fall-through
         EXPECT_NEAR(t.getOrigin().z(), 0.5, 0.02) << "box " << b;
         EXPECT_LT(box->getLinearVelocity().length(), 0.05) << "box " << b;
