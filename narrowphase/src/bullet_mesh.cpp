@@ -325,16 +325,17 @@ void insideVertices(const PairContact& c, int patch, const Vec3& n, const Vec3& 
     }
 }
 
-void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out);
+void chooseContacts(const ContactScratch& s, double separation, std::vector<MeshContact>& out);
 
-/// Up to 4 contacts (in A's frame, X = A) from the query's pairs. `bInA` is the pose the
-/// query used: B's vertices are classified as bInA.apply(q), and so are they here. The
-/// candidate normals point from A towards B; a face normal of a mesh whose winding does not
-/// say where its outside is (`sidesA`, `sidesB`) is turned to point out of its triangle as
-/// Sides says (an open surface has no inside: a wrong guess would push a body through it).
+/// Up to 4 contacts (in A's frame, X = A) from the query's pairs, no two within `separation`
+/// of each other. `bInA` is the pose the query used: B's vertices are classified as
+/// bInA.apply(q), and so are they here. The candidate normals point from A towards B; a face
+/// normal of a mesh whose winding does not say where its outside is (`sidesA`, `sidesB`) is
+/// turned to point out of its triangle as Sides says (an open surface has no inside: a wrong
+/// guess would push a body through it).
 void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
-                   const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s,
-                   std::vector<MeshContact>& out) {
+                   const RelativePose& bInA, Sides sidesA, Sides sidesB, double separation,
+                   ContactScratch& s, std::vector<MeshContact>& out) {
     out.clear();
     const std::size_t count = result.contacts.size();
     s.patches.assign(count, Patch{});
@@ -390,7 +391,7 @@ void buildContacts(const QueryResult& result, const TriangleMesh& meshA, const T
     if (s.candidates.empty()) {
         return;
     }
-    chooseContacts(s, out);
+    chooseContacts(s, separation, out);
 }
 
 /// The patches of the intersecting pairs (s.sorted in pair order, s.root, s.patches).
@@ -602,8 +603,10 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
     }
 }
 
-/// Up to 4 of s.candidates (not empty) as contacts.
-void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
+/// Up to 4 of s.candidates (not empty) as contacts, no two within `separation` (the
+/// manifold's breaking threshold): Bullet merges a new point into the nearest point within it
+/// (getCacheEntry), so of two new points closer than that the second replaced the first.
+void chooseContacts(const ContactScratch& s, double separation, std::vector<MeshContact>& out) {
     // Bullet's choice of 4 points: the deepest, the farthest from it, the largest triangle,
     // the largest quadrilateral (diagonal cross products, as in sortCachedPoints).
     std::array<int, 4> chosen{};
@@ -621,9 +624,11 @@ void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
     for (const Candidate& c : s.candidates) {
         scale = std::max(scale, (c.point - s.candidates[chosen[0]].point).squaredNorm());
     }
-    // Lengths below 1e-9 of the patch's extent count as zero: no point is chosen twice, and
-    // the areas must be real (steps 2 and 3 compare squared areas).
+    // Lengths below 1e-9 of the patch's extent count as zero: the areas must be real (steps 2
+    // and 3 compare squared areas), and no point is chosen within that or `separation` of
+    // one chosen before.
     const double tinyLength = 1e-18 * scale;
+    const double apart = std::max(tinyLength, separation * separation);
     for (int step = 1; step < 4 && scale > 0; ++step) {
         int best = -1;
         double bestValue = step == 1 ? tinyLength : tinyLength * scale;
@@ -644,12 +649,12 @@ void chooseContacts(const ContactScratch& s, std::vector<MeshContact>& out) {
                                   (p0 - p).cross(p1 - p2).squaredNorm()});
             }
             if (value > bestValue) {
-                // A point already chosen (within tinyLength) is never chosen again. Only the
-                // points that would win are checked: the same choice as skipping repeats first.
+                // Only the points that would win are checked for a chosen one nearby: the same
+                // choice as skipping those first.
                 bool repeated = false;
                 for (int k = 0; k < chosenCount; ++k) {
                     repeated =
-                        repeated || (p - s.candidates[chosen[k]].point).squaredNorm() <= tinyLength;
+                        repeated || (p - s.candidates[chosen[k]].point).squaredNorm() <= apart;
                 }
                 if (!repeated) {
                     bestValue = value;
@@ -741,6 +746,11 @@ double contactMargin(detail::PairStages& stages, const btPersistentManifold* man
                  : 0.0;
     const double asked = result != nullptr ? double(result->m_closestPointDistanceThreshold) : 0.0;
     return std::isfinite(asked) && asked > margin ? asked : margin;
+}
+
+/// The manifold's breaking threshold, 0 without one.
+double breakingThreshold(const btPersistentManifold* manifold) {
+    return manifold != nullptr ? double(manifold->getContactBreakingThreshold()) : 0.0;
 }
 
 /// After refreshContactPoints, for two meshes the exact test found apart: the kept points'
@@ -1243,7 +1253,7 @@ void MeshMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         if (result.intersecting || !result.near.empty()) {
             buildContacts(result, shapeA->model().mesh(), shapeB->model().mesh(),
                           RelativePose(poseA, poseB), sidesOf(*shapeA), sidesOf(*shapeB),
-                          contactScratch, state_->contacts);
+                          breakingThreshold(manifold_), contactScratch, state_->contacts);
             toWorld(state_->contacts, poseA);
             dropStalePoints(ownManifold_, resultOut);
             emit(state_->contacts, true, resultOut);
@@ -1519,7 +1529,7 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
             if (result.intersecting || !result.near.empty()) {
                 buildContacts(result, shape->model().mesh(), sceneryModel.mesh(),
                               RelativePose(meshPose, identity), sidesOf(*shape), Sides::kScenery,
-                              contactScratch, state_->contacts);
+                              breakingThreshold(manifold_), contactScratch, state_->contacts);
                 toWorld(state_->contacts, meshPose);
                 for (MeshContact& c : state_->contacts) {
                     c.partY = ids[c.triangleY].first;
