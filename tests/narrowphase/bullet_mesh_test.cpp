@@ -676,6 +676,26 @@ struct Floor {
     btRigidBody* boxes[2];
 };
 
+/// The one manifold of a pair's algorithm (null unless there is exactly one).
+const btPersistentManifold* onlyManifold(btCollisionAlgorithm* algorithm) {
+    btManifoldArray manifolds;
+    algorithm->getAllContactManifolds(manifolds);
+    return manifolds.size() == 1 ? manifolds[0] : nullptr;
+}
+
+/// Whether the manifold holds a point whose middle is `point` (within 0.1 mm).
+bool holds(const btPersistentManifold& m, const Vec3& point) {
+    for (int k = 0; k < m.getNumContacts(); ++k) {
+        const btManifoldPoint& p = m.getContactPoint(k);
+        const Vec3 middle =
+            0.5 * (toVec3(p.getPositionWorldOnA()) + toVec3(p.getPositionWorldOnB()));
+        if ((middle - point).norm() < 1e-4) {
+            return true;
+        }
+    }
+    return false;
+}
+
 /// Regression: a box sliding farther per step than its manifold's breaking threshold (here
 /// 3.3 cm against 1.7 cm) lost new points. The manifold was full of the last step's points,
 /// stale but dropped only by the refresh after the new ones went in; Bullet's choice of which
@@ -692,22 +712,14 @@ TEST(BulletMeshContacts, ABoxSlidingFasterThanTheBreakingThresholdKeepsEveryNewP
         w.world.stepSimulation(btScalar(1.0 / 60), 0);
         auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(scene.floor, box));
         ASSERT_NE(algorithm, nullptr);
-        btManifoldArray manifolds;
-        algorithm->getAllContactManifolds(manifolds);
-        ASSERT_EQ(manifolds.size(), 1);
-        const btPersistentManifold* m = manifolds[0];
+        const btPersistentManifold* m = onlyManifold(algorithm);
+        ASSERT_NE(m, nullptr);
         ASSERT_LT(m->getContactBreakingThreshold(), 0.033f) << "the box must slide farther";
         const std::vector<kolize::MeshContact>& contacts = algorithm->lastContacts();
         for (const kolize::MeshContact& c : contacts) {
-            bool held = false;
-            for (int k = 0; k < m->getNumContacts(); ++k) {
-                const btManifoldPoint& p = m->getContactPoint(k);
-                const Vec3 middle =
-                    0.5 * (toVec3(p.getPositionWorldOnA()) + toVec3(p.getPositionWorldOnB()));
-                held = held || (middle - c.point).norm() < 1e-4;
-            }
-            EXPECT_TRUE(held) << "step " << step << ": a point made this step is not held, at "
-                              << c.point.transpose();
+            EXPECT_TRUE(holds(*m, c.point))
+                << "step " << step << ": a point made this step is not held, at "
+                << c.point.transpose();
         }
         checked += int(contacts.size());
     }
@@ -766,10 +778,8 @@ TEST(BulletMeshContacts, NoTwoNewPointsAreCloserThanTheBreakingThreshold) {
             contacts = &scenery->lastContacts();
         }
         ASSERT_NE(contacts, nullptr) << "case " << i;
-        btManifoldArray manifolds;
-        algorithm->getAllContactManifolds(manifolds);
-        ASSERT_EQ(manifolds.size(), 1);
-        const btPersistentManifold* m = manifolds[0];
+        const btPersistentManifold* m = onlyManifold(algorithm);
+        ASSERT_NE(m, nullptr) << "case " << i;
         const std::string where = "case " + std::to_string(i) + ", seed " + std::to_string(seed);
         for (std::size_t k = 0; k < contacts->size(); ++k) {
             const kolize::MeshContact& c = (*contacts)[k];
@@ -777,14 +787,8 @@ TEST(BulletMeshContacts, NoTwoNewPointsAreCloserThanTheBreakingThreshold) {
                 EXPECT_GT((c.point - (*contacts)[j].point).norm(), m->getContactBreakingThreshold())
                     << where;
             }
-            bool held = false;
-            for (int n = 0; n < m->getNumContacts(); ++n) {
-                const btManifoldPoint& p = m->getContactPoint(n);
-                const Vec3 middle =
-                    0.5 * (toVec3(p.getPositionWorldOnA()) + toVec3(p.getPositionWorldOnB()));
-                held = held || (middle - c.point).norm() < 1e-4;
-            }
-            EXPECT_TRUE(held) << where << ": a point made is not held, at " << c.point.transpose();
+            EXPECT_TRUE(holds(*m, c.point))
+                << where << ": a point made is not held, at " << c.point.transpose();
         }
         points += int(contacts->size());
         cases += contacts->empty() ? 0 : 1;
@@ -820,10 +824,9 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
             // merge them): a box resting a hair tilted on a sliver at its corner has 1.
             areaFrames[b] += contacts.size() >= 3 ? 1 : 0;
             EXPECT_LE(contacts.size(), 4u) << "box " << b;
-            btManifoldArray manifolds;
-            algorithm->getAllContactManifolds(manifolds);
-            ASSERT_EQ(manifolds.size(), 1);
-            const double threshold = manifolds[0]->getContactBreakingThreshold();
+            const btPersistentManifold* m = onlyManifold(algorithm);
+            ASSERT_NE(m, nullptr);
+            const double threshold = m->getContactBreakingThreshold();
             for (std::size_t k = 0; k < contacts.size(); ++k) {
                 for (std::size_t j = 0; j < k; ++j) {
                     EXPECT_GT((contacts[j].point - contacts[k].point).norm(), threshold)
@@ -894,10 +897,8 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
         EXPECT_GT(t.getBasis().getColumn(2).z(), 0.9999) << "box " << b << " tilted";
         auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(scene.floor, box));
         ASSERT_NE(algorithm, nullptr);
-        btManifoldArray manifolds;
-        algorithm->getAllContactManifolds(manifolds);
-        ASSERT_EQ(manifolds.size(), 1);
-        const btPersistentManifold* m = manifolds[0];
+        const btPersistentManifold* m = onlyManifold(algorithm);
+        ASSERT_NE(m, nullptr);
         // No ghost contacts: every point Bullet holds is under the box, on the floor, with
         // the floor's normal (on body1, towards body0).
         const double expectedZ = m->getBody0() == scene.floor ? -1 : 1;
