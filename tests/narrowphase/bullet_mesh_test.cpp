@@ -554,6 +554,17 @@ double overlapAlong(const std::vector<Vec3>& lower, const std::vector<Vec3>& upp
     return highest - lowest;
 }
 
+/// No two contacts within `threshold` of each other (Bullet would merge them).
+void expectApart(const std::vector<kolize::MeshContact>& contacts, double threshold,
+                 const std::string& where) {
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+        for (std::size_t j = 0; j < k; ++j) {
+            EXPECT_GT((contacts[j].point - contacts[k].point).norm(), threshold)
+                << "points Bullet merges, " << where;
+        }
+    }
+}
+
 TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
     World w;
     Stack stack(w);
@@ -588,6 +599,8 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
             // merge them): a box resting tilted on a sliver near its corner has 2.
             areaFrames[i] += contacts.size() >= 3 ? 1 : 0;
             ASSERT_LE(contacts.size(), 4u) << "level " << i << " step " << step;
+            expectApart(contacts, manifolds[0]->getContactBreakingThreshold(),
+                        "level " + std::to_string(i) + " step " + std::to_string(step));
             const std::vector<Vec3> lowerVertices = boxVertices(poses[i], halves[i]);
             const std::vector<Vec3> upperVertices = boxVertices(poses[i + 1], halves[i + 1]);
             // The exact normal is one of the two facing faces' normals: the lower box's top,
@@ -615,11 +628,6 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
                 vertexPoints +=
                     checkBoxContact(c, poses[x], halves[x], poses[y], halves[y], exactDepth,
                                     "level " + std::to_string(i) + " step " + std::to_string(step));
-                for (std::size_t j = 0; j < k; ++j) {
-                    EXPECT_GT((contacts[j].point - c.point).norm(),
-                              manifolds[0]->getContactBreakingThreshold())
-                        << "points Bullet merges, level " << i << " step " << step;
-                }
                 EXPECT_GE(c.triangleX, 0);
                 EXPECT_LT(c.triangleX, 12);
                 EXPECT_GE(c.triangleY, 0);
@@ -781,12 +789,8 @@ TEST(BulletMeshContacts, NoTwoNewPointsAreCloserThanTheBreakingThreshold) {
         const btPersistentManifold* m = onlyManifold(algorithm);
         ASSERT_NE(m, nullptr) << "case " << i;
         const std::string where = "case " + std::to_string(i) + ", seed " + std::to_string(seed);
-        for (std::size_t k = 0; k < contacts->size(); ++k) {
-            const kolize::MeshContact& c = (*contacts)[k];
-            for (std::size_t j = 0; j < k; ++j) {
-                EXPECT_GT((c.point - (*contacts)[j].point).norm(), m->getContactBreakingThreshold())
-                    << where;
-            }
+        expectApart(*contacts, m->getContactBreakingThreshold(), where);
+        for (const kolize::MeshContact& c : *contacts) {
             EXPECT_TRUE(holds(*m, c.point))
                 << where << ": a point made is not held, at " << c.point.transpose();
         }
@@ -826,13 +830,8 @@ TEST(BulletMeshContacts, BoxMeshRestsOnATriangleMeshFloorWithoutGhostContacts) {
             EXPECT_LE(contacts.size(), 4u) << "box " << b;
             const btPersistentManifold* m = onlyManifold(algorithm);
             ASSERT_NE(m, nullptr);
-            const double threshold = m->getContactBreakingThreshold();
-            for (std::size_t k = 0; k < contacts.size(); ++k) {
-                for (std::size_t j = 0; j < k; ++j) {
-                    EXPECT_GT((contacts[j].point - contacts[k].point).norm(), threshold)
-                        << "points Bullet merges, box " << b << " step " << step;
-                }
-            }
+            expectApart(contacts, m->getContactBreakingThreshold(),
+                        "box " + std::to_string(b) + " step " + std::to_string(step));
             const std::vector<Vec3> vertices = boxVertices(poses[b], Vec3::Constant(0.5));
             double exactDepth = 0;
             for (const Vec3& v : vertices) {
