@@ -338,6 +338,27 @@ CoreScenarioResult runCoreScenario(Core& core, const CoreScenario& scenario) {
         if (gotRay != wantRay) {
             return result;
         }
+        // And a box query, each object at most once (the sweep applies moves at the next
+        // maintain(): moved objects are visited apart from its sorted arrays).
+        got.clear();
+        want.clear();
+        bool repeated = false;
+        core.queryBox(query, [&](ObjectId id) {
+            if (overlaps(box[id], query) && !got.insert(id).second) {
+                repeated = true;
+            }
+        });
+        for (ObjectId id : liveIds) {
+            if (overlaps(box[id], query)) {
+                want.insert(id);
+            }
+        }
+        EXPECT_EQ(got, want) << "box query after moves, operation " << operation;
+        EXPECT_FALSE(repeated) << "box query after moves reported an object twice, operation "
+                               << operation;
+        if (got != want || repeated) {
+            return result;
+        }
     }
     return result;
 }

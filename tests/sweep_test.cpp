@@ -1,9 +1,14 @@
 // The sweep core's own overlap tracking (drainChanges), checked against a plain brute force:
 // a set of pairs kept only from the drained changes (each one re-tested exactly) must equal
 // the truly overlapping pairs after every frame, under seeded random moves, jitter of
-// near-equal coordinates, removals and ids re-used before the next maintain().
+// near-equal coordinates, removals and ids re-used before the next maintain(); with many
+// objects moved per frame (their moves applied in one insertion pass per axis) and with few
+// (one object at a time). And the core test kit (candidates, box and ray queries, also
+// between update() and the next maintain()) against its brute force.
 
 #include <kolize/broadphase/sweep_and_prune.h>
+
+#include "core_kit.h"
 
 #include <gtest/gtest.h>
 
@@ -11,6 +16,7 @@
 #include <cstdio>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -35,10 +41,13 @@ Pair ordered(kolize::ObjectId a, kolize::ObjectId b) {
 struct Tracked {
     std::size_t frames = 0, pairsSeen = 0, reusedBeforeMaintain = 0, changes = 0;
     std::size_t oneAxisMoves = 0, oneEndMoves = 0;
+    std::size_t batched = 0, oneByOne = 0;  ///< the core's counters at the end
 };
 
-Tracked runTracked(std::uint32_t seed, bool lattice) {
-    std::printf("sweep tracking, seed %u, %s\n", seed, lattice ? "lattice" : "random");
+/// `opsPerFrame` random operations between two maintain() calls, `frames` times.
+Tracked runTracked(std::uint32_t seed, bool lattice, int opsPerFrame, int frames) {
+    std::printf("sweep tracking, seed %u, %s, %d operations per frame\n", seed,
+                lattice ? "lattice" : "random", opsPerFrame);
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> unit(0, 1);
     kolize::SweepAndPrune<3, float> core;
@@ -59,8 +68,8 @@ Tracked runTracked(std::uint32_t seed, bool lattice) {
     };
     std::set<Pair> tracked;
     Tracked out;
-    for (int frame = 0; frame < 200; ++frame) {
-        for (int op = 0; op < 40; ++op) {
+    for (int frame = 0; frame < frames; ++frame) {
+        for (int op = 0; op < opsPerFrame; ++op) {
             const int id = int(rng() % kObjects);
             const float roll = unit(rng);
             if (!live[id]) {
@@ -136,23 +145,156 @@ Tracked runTracked(std::uint32_t seed, bool lattice) {
         out.pairsSeen += truth.size();
         ++out.frames;
     }
+    out.batched = core.batchedSearches();
+    out.oneByOne = core.oneByOneSearches();
     return out;
 }
 
 TEST(SweepTracking, DrainedChangesKeepTheExactPairsUnderMovesJitterAndReusedIds) {
-    for (std::uint32_t seed = 1; seed <= 4; ++seed) {
-        for (bool lattice : {false, true}) {
-            const Tracked t = runTracked(seed, lattice);
-            EXPECT_EQ(t.frames, 200u);
-            // The sample means something: pairs, changes and re-used ids occurred.
-            EXPECT_GT(t.pairsSeen, 200u * 20);
-            EXPECT_GT(t.changes, 1000u);
-            EXPECT_GT(t.reusedBeforeMaintain, 50u);
-            // Moves that keep some intervals (skipped axes must be exactly those).
-            EXPECT_GT(t.oneAxisMoves, 500u);
-            EXPECT_GT(t.oneEndMoves, 500u);
+    // 40 operations per frame move about a third of the 120 objects (one insertion pass
+    // per axis); 3 move one object in 40 (one at a time). The same number of operations.
+    struct Mode {
+        int opsPerFrame, frames;
+        bool batched;
+    };
+    for (const Mode mode : {Mode{40, 200, true}, Mode{3, 2667, false}}) {
+        for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+            for (bool lattice : {false, true}) {
+                const Tracked t = runTracked(seed, lattice, mode.opsPerFrame, mode.frames);
+                EXPECT_EQ(t.frames, std::size_t(mode.frames));
+                // The sample means something: pairs, changes and re-used ids occurred.
+                EXPECT_GT(t.pairsSeen, std::size_t(mode.frames) * 20);
+                EXPECT_GT(t.changes, 1000u);
+                EXPECT_GT(t.reusedBeforeMaintain, 50u);
+                // Moves that keep some intervals (skipped axes must be exactly those).
+                EXPECT_GT(t.oneAxisMoves, 500u);
+                EXPECT_GT(t.oneEndMoves, 500u);
+                // The frames took the way of applying moves this mode is for.
+                EXPECT_GT(mode.batched ? t.batched : t.oneByOne, std::size_t(mode.frames) * 9 / 10);
+            }
         }
     }
+}
+
+// A stack's layer: 64 unit boxes side by side whose lows and highs are equal but for a
+// jitter of a few ulps, all moved every frame. One insertion pass per axis reorders the
+// tied endpoints; the drained changes must still keep the exact pairs, and the passes must
+// swap only what changed order (boxes translated together swap nothing).
+TEST(SweepTracking, ABatchOfTiedJitteringEndpointsKeepsTheExactPairs) {
+    std::mt19937 rng(7);
+    std::printf("tied jitter, seed 7\n");
+    kolize::SweepAndPrune<3, float> core;
+    std::vector<Box> boxes;
+    for (int i = 0; i < 64; ++i) {
+        const float x = float(i % 8), z = float(i / 8);
+        boxes.push_back(Box{{x, 0, z}, {x + 1, 1, z + 1}});
+        core.insert(kolize::ObjectId(i), boxes.back());
+    }
+    std::set<Pair> tracked;
+    auto drain = [&] {
+        core.maintain();
+        core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
+            if (overlap(boxes[a], boxes[b])) {
+                tracked.insert(ordered(a, b));
+            } else {
+                tracked.erase(ordered(a, b));
+            }
+        });
+    };
+    auto truth = [&] {
+        std::set<Pair> out;
+        for (kolize::ObjectId a = 0; a < boxes.size(); ++a) {
+            for (kolize::ObjectId b = a + 1; b < boxes.size(); ++b) {
+                if (overlap(boxes[a], boxes[b])) {
+                    out.insert({a, b});
+                }
+            }
+        }
+        return out;
+    };
+    drain();
+    ASSERT_EQ(tracked, truth());
+    std::size_t changedFrames = 0;
+    for (int frame = 0; frame < 300; ++frame) {
+        for (kolize::ObjectId id = 0; id < boxes.size(); ++id) {
+            Box& box = boxes[id];
+            for (int axis = 0; axis < 3; ++axis) {
+                // Up to 2 ulps either way, on each end apart: touching neighbours come apart
+                // and meet again.
+                const int ulps = int(rng() % 5) - 2;
+                box.lo[axis] = std::nextafter(box.lo[axis], ulps < 0 ? -1e9f : 1e9f);
+                if (ulps == 0 || std::abs(ulps) == 2) {
+                    box.hi[axis] = std::nextafter(box.hi[axis], ulps < 0 ? -1e9f : 1e9f);
+                }
+                box.hi[axis] = std::max(box.hi[axis], box.lo[axis]);
+            }
+            core.update(id, box);
+        }
+        const std::set<Pair> before = tracked;
+        drain();
+        ASSERT_EQ(tracked, truth()) << "frame " << frame;
+        changedFrames += tracked != before ? 1 : 0;
+        core.validate();
+    }
+    EXPECT_GT(changedFrames, 100u) << "the jitter must make and break pairs";
+    EXPECT_EQ(core.batchedSearches(), 300u);
+}
+
+// Boxes moved together keep every order: a pass swaps nothing. A lattice of unit boxes
+// touching exactly, all translated by a quarter (exact in float) every frame.
+TEST(SweepTracking, ABatchTranslatedTogetherSwapsNothing) {
+    kolize::SweepAndPrune<3, float> core;
+    std::vector<Box> boxes;
+    for (int i = 0; i < 64; ++i) {
+        const float x = float(i % 8), z = float(i / 8);
+        boxes.push_back(Box{{x, 0, z}, {x + 1, 1, z + 1}});
+        core.insert(kolize::ObjectId(i), boxes.back());
+    }
+    core.maintain();
+    std::size_t pairs = 0;
+    core.drainChanges([&](kolize::ObjectId, kolize::ObjectId) { ++pairs; });
+    EXPECT_EQ(pairs, 7u * 8 * 2 + 7 * 7 * 2) << "faces and diagonal corners touch";
+    for (int frame = 0; frame < 10; ++frame) {
+        for (kolize::ObjectId id = 0; id < boxes.size(); ++id) {
+            for (int axis = 0; axis < 3; ++axis) {
+                boxes[id].lo[axis] += 0.25f;
+                boxes[id].hi[axis] += 0.25f;
+            }
+            core.update(id, boxes[id]);
+        }
+        core.maintain();
+        core.drainChanges([&](kolize::ObjectId, kolize::ObjectId) { ++pairs; });
+        core.validate();
+    }
+    EXPECT_EQ(core.batchedSearches(), 10u);
+    EXPECT_EQ(core.swaps(), 0u);
+    EXPECT_EQ(pairs, 7u * 8 * 2 + 7 * 7 * 2) << "no change recorded";
+}
+
+template <int D, class Scalar>
+void runSweepKit(std::uint64_t seed) {
+    // Pairs searched every 7 operations (most moves applied in one pass per axis) and after
+    // every operation (a frame of 1-20 moves among up to 150 objects: mostly one by one).
+    for (int every : {7, 1}) {
+        SCOPED_TRACE("a pair search every " + std::to_string(every) + " operations");
+        kolize::SweepAndPrune<D, Scalar> core;
+        kolize::testkit::CoreScenario scenario;
+        scenario.seed = seed;
+        scenario.checkEvery = every;
+        kolize::testkit::expectMeaningful(
+            kolize::testkit::runCoreScenario<D, Scalar>(core, scenario));
+        EXPECT_GT(every == 1 ? core.oneByOneSearches() : core.batchedSearches(), 20u);
+    }
+}
+
+TEST(SweepCore, Sweep3MatchesTheOracle) {
+    runSweepKit<3, float>(21);
+}
+TEST(SweepCore, Sweep2MatchesTheOracle) {
+    runSweepKit<2, float>(22);
+}
+TEST(SweepCore, Sweep3DoubleMatchesTheOracle) {
+    runSweepKit<3, double>(23);
 }
 
 }  // namespace

@@ -7,8 +7,11 @@
 /// carried to their new places by adjacent swaps, as Bullet's btAxisSweep3 does; a min
 /// passing another object's max (or the reverse) is where the two intervals start or stop
 /// overlapping on that axis, and when their other axes overlap, the pair is recorded as
-/// changed. Work per frame: O(moved objects + swaps); objects at rest cost nothing, and an
-/// axis on which a moved box kept its interval is not touched.
+/// changed. Moves are applied at the next pair search (maintain()): one object at a time
+/// when under one in eight moved, else one insertion pass per axis (a jittering stack's
+/// tied endpoints swap in a contiguous array, positions written once). Work per frame:
+/// O(moved objects + swaps), plus O(N) per changed axis for a pass; objects at rest cost
+/// nothing, and an axis on which no moved box changed its interval is not touched.
 ///
 /// Unlike btAxisSweep3: the endpoints are the exact box coordinates (no quantisation, so no
 /// world bounds and no extra pairs), ids are 32-bit (no 16-bit handle limit), and objects
@@ -114,6 +117,8 @@ class SweepAndPrune {
             const std::size_t size = std::size_t(id) + 1;
             state_.resize(size, State::Absent);
             boxes_.resize(size);
+            next_.resize(size);
+            dirty_.resize(size, 0);
             at_.resize(size);
             pendingAt_.resize(size, kSettled);
         }
@@ -124,42 +129,18 @@ class SweepAndPrune {
         ++size_;
     }
 
-    /// Moves object `id`: its endpoints swap their way to the new values.
+    /// Moves object `id` to `box`, applied at the next maintain() (or pair search): there
+    /// the moved objects' endpoints swap their way to the new values, one object at a time
+    /// when few moved, else in one insertion pass per axis (see applyMoves).
     void update(ObjectId id, const Box& box) {
-        Box& old = boxes_[id];
         if (state_[id] == State::Pending) {
-            old = box;
+            boxes_[id] = box;
             return;
         }
-        for (int axis = 0; axis < D; ++axis) {
-            // An axis whose interval did not change costs nothing: falling and sliding
-            // bodies change one or two of the three, and the object's box is one cache line
-            // where the endpoints are six.
-            if (old.lo[axis] == box.lo[axis] && old.hi[axis] == box.hi[axis]) {
-                continue;
-            }
-            old.lo[axis] = box.lo[axis];
-            old.hi[axis] = box.hi[axis];
-            std::vector<Endpoint>& edges = axes_[axis];
-            const std::uint32_t low = at_[id][2 * axis], high = at_[id][2 * axis + 1];
-            edges[low].setValue(box.lo[axis]);
-            edges[high].setValue(box.hi[axis]);
-            // Whether an endpoint has to move at all is one well-predicted test: jitter
-            // rarely passes a neighbour, while its direction would be a coin toss. A max
-            // moving up goes first and one moving down last, so that the min is never
-            // blocked by its own max (and neither ever passes the other).
-            if (high + 1 < edges.size() && before(edges[high + 1], edges[high])) {
-                sortUp(axis, high);
-            }
-            if (low > 0 && before(edges[low], edges[low - 1])) {
-                sortDown(axis, low);
-            } else if (before(edges[low + 1], edges[low])) {
-                sortUp(axis, low);
-            }
-            const std::uint32_t max = at_[id][2 * axis + 1];
-            if (before(edges[max], edges[max - 1])) {
-                sortDown(axis, max);
-            }
+        next_[id] = box;
+        if (!dirty_[id]) {
+            dirty_[id] = 1;
+            moved_.push_back(id);
         }
     }
 
@@ -178,9 +159,13 @@ class SweepAndPrune {
         --size_;
     }
 
-    /// Before every pair search: compacts removed objects' endpoints out and merges the
-    /// created ones in, recording every pair of a merged object whose boxes overlap.
+    /// Before every pair search: applies the moves, compacts removed objects' endpoints out
+    /// and merges the created ones in, recording every pair of a merged object whose boxes
+    /// overlap.
     void maintain() {
+        if (!moved_.empty()) {
+            applyMoves();
+        }
         if (dead_ > 0) {
             compact();
         }
@@ -226,16 +211,22 @@ class SweepAndPrune {
         }
     }
 
-    /// Objects whose first-axis interval meets the box's (a superset; pending objects all).
+    /// Objects whose first-axis interval meets the box's (a superset; pending objects and
+    /// objects moved since the last maintain() all, once each).
     template <class Visit>
     void queryBox(const Box& box, Visit&& visit) const {
         for (ObjectId id : pending_) {
             visit(id);
         }
+        for (ObjectId id : moved_) {
+            if (state_[id] == State::Sorted) {
+                visit(id);
+            }
+        }
         const std::vector<Endpoint>& edges = axes_[0];
         for (std::size_t at = 0; at < edges.size() && !(edges[at].value() > box.hi[0]); ++at) {
             const ObjectId id = edges[at].id();
-            if (!edges[at].isMax() && state_[id] == State::Sorted &&
+            if (!edges[at].isMax() && state_[id] == State::Sorted && !dirty_[id] &&
                 !(edges[at_[id][1]].value() < box.lo[0])) {
                 visit(id);
             }
@@ -256,6 +247,10 @@ class SweepAndPrune {
     /// Endpoint swaps so far (the work of update()), and changed pairs recorded.
     std::size_t swaps() const { return swaps_; }
     std::size_t changesRecorded() const { return changesRecorded_; }
+    /// Pair searches whose moves were applied in one insertion pass per axis, and those
+    /// applied one object at a time.
+    std::size_t batchedSearches() const { return batchedSearches_; }
+    std::size_t oneByOneSearches() const { return oneByOneSearches_; }
 
     /// Checks the arrays' order, the endpoint positions and values against the boxes, and
     /// the counts; throws std::logic_error.
@@ -308,13 +303,27 @@ class SweepAndPrune {
                 fail("axis " + std::to_string(axis) + " holds the wrong number of endpoints");
             }
         }
+        std::size_t flagged = 0;
+        for (ObjectId id = 0; id < dirty_.size(); ++id) {
+            flagged += dirty_[id];
+        }
+        for (ObjectId id : moved_) {
+            if (!dirty_[id]) {
+                fail("moved object " + std::to_string(id) + " not flagged");
+            }
+        }
+        if (flagged != moved_.size()) {
+            fail("moved list and flags disagree");
+        }
         if (pending != pending_.size() || dead != dead_ || sorted + pending != size_) {
             fail("object counts disagree");
         }
     }
 
     std::size_t memoryBytes() const {
-        std::size_t bytes = state_.capacity() + boxes_.capacity() * sizeof(Box) +
+        std::size_t bytes = state_.capacity() + dirty_.capacity() +
+                            (boxes_.capacity() + next_.capacity()) * sizeof(Box) +
+                            moved_.capacity() * sizeof(ObjectId) +
                             at_.capacity() * sizeof(Positions) +
                             changes_.capacity() * sizeof(Change) +
                             (pendingAt_.capacity() + pending_.capacity() + active_.capacity() +
@@ -337,6 +346,9 @@ class SweepAndPrune {
         ObjectId a, b;
     };
     static constexpr std::uint32_t kSettled = 0xffffffffu;
+    /// Moves are applied in one pass per axis when at least one sorted object in this many
+    /// moved.
+    static constexpr std::size_t kBatchFrom = 8;
 
     /// Whether objects a and b overlap on every axis but `skip`, by the positions of their
     /// endpoints (the arrays' present order, which later swaps start from).
@@ -354,6 +366,140 @@ class SweepAndPrune {
             }
         }
         return true;
+    }
+
+    /// Applies the moves since the last maintain(). Few moved objects (under one in
+    /// kBatchFrom of the sorted ones) go one at a time (moveOne: their endpoints swap to
+    /// their places, the arrays sorted after each). Many go in one pass per axis: every
+    /// moved endpoint takes its new value where it is, then an insertion sort over the axis
+    /// swaps exactly the endpoints whose order changed, and the positions are written once
+    /// at the end. Same-kind endpoints of a stack's layer, which jitter reorders by the
+    /// thousand each frame, then cost a move in a contiguous array each instead of a
+    /// position update of another object.
+    ///
+    /// Why a batch records every pair whose overlap changed: on each axis the insertion sort
+    /// swaps every pair of endpoints whose order changed exactly once, and a swap of a min
+    /// and a max is recorded when the other axes overlap by the positions at that moment
+    /// (new for the axes already sorted, old for the others). A pair that stops overlapping
+    /// is recorded at its first change (every other relation still as before: overlapping);
+    /// one that starts, at its last (every other relation already as after).
+    void applyMoves() {
+        std::size_t live = 0;
+        for (ObjectId id : moved_) {
+            live += state_[id] == State::Sorted ? 1 : 0;
+        }
+        const std::size_t sorted = size_ - pending_.size();
+        if (live * kBatchFrom < sorted) {
+            for (ObjectId id : moved_) {
+                dirty_[id] = 0;
+                if (state_[id] == State::Sorted) {
+                    moveOne(id, next_[id]);
+                }
+            }
+            ++oneByOneSearches_;
+        } else {
+            bool changed[D] = {};
+            for (ObjectId id : moved_) {
+                dirty_[id] = 0;
+                if (state_[id] != State::Sorted) {
+                    continue;
+                }
+                Box& old = boxes_[id];
+                const Box& box = next_[id];
+                for (int axis = 0; axis < D; ++axis) {
+                    if (old.lo[axis] == box.lo[axis] && old.hi[axis] == box.hi[axis]) {
+                        continue;
+                    }
+                    axes_[axis][at_[id][2 * axis]].setValue(box.lo[axis]);
+                    axes_[axis][at_[id][2 * axis + 1]].setValue(box.hi[axis]);
+                    changed[axis] = true;
+                }
+                old = box;
+            }
+            for (int axis = 0; axis < D; ++axis) {
+                if (changed[axis]) {
+                    insertionPass(axis);
+                }
+            }
+            ++batchedSearches_;
+        }
+        moved_.clear();
+    }
+
+    /// One insertion sort over `axis`, whose arrays' moved endpoints hold their new values
+    /// at their old places (see applyMoves). The positions on this axis are stale during
+    /// the pass (the overlap tests read the other axes only) and rewritten over the range
+    /// that changed.
+    void insertionPass(int axis) {
+        // Raw pointers: the arrays do not change size here, and the compiler need not reload
+        // them after every store or recorded change.
+        Endpoint* const edges = axes_[axis].data();
+        const Positions* const at = at_.data();
+        const std::size_t n = axes_[axis].size();
+        std::size_t first = n, last = 0, passed = 0;
+        for (std::size_t i = 1; i < n; ++i) {
+            if (!before(edges[i], edges[i - 1])) {
+                continue;
+            }
+            const Endpoint moving = edges[i];
+            const ObjectId id = moving.id();
+            const bool isMax = moving.isMax();
+            const Positions mine = at[id];
+            std::size_t to = i;
+            do {
+                const Endpoint next = edges[to - 1];
+                if (next.isMax() != isMax && overlapsOnOtherAxes(mine, at[next.id()], axis)) {
+                    changes_.push_back(Change{id, next.id()});
+                    ++changesRecorded_;
+                }
+                edges[to] = next;
+                --to;
+            } while (to > 0 && before(moving, edges[to - 1]));
+            passed += i - to;
+            edges[to] = moving;
+            first = std::min(first, to);
+            last = i;
+        }
+        for (std::size_t k = first; k <= last && k < n; ++k) {
+            at_[edges[k].id()][2 * axis + (edges[k].isMax() ? 1 : 0)] = std::uint32_t(k);
+        }
+        swaps_ += passed;
+    }
+
+    /// Moves one object to `box` in sorted arrays: its endpoints swap their way to the new
+    /// values.
+    void moveOne(ObjectId id, const Box& box) {
+        Box& old = boxes_[id];
+        for (int axis = 0; axis < D; ++axis) {
+            // An axis whose interval did not change costs nothing: falling and sliding
+            // bodies change one or two of the three, and the object's box is one cache line
+            // where the endpoints are six.
+            if (old.lo[axis] == box.lo[axis] && old.hi[axis] == box.hi[axis]) {
+                continue;
+            }
+            old.lo[axis] = box.lo[axis];
+            old.hi[axis] = box.hi[axis];
+            std::vector<Endpoint>& edges = axes_[axis];
+            const std::uint32_t low = at_[id][2 * axis], high = at_[id][2 * axis + 1];
+            edges[low].setValue(box.lo[axis]);
+            edges[high].setValue(box.hi[axis]);
+            // Whether an endpoint has to move at all is one well-predicted test: jitter
+            // rarely passes a neighbour, while its direction would be a coin toss. A max
+            // moving up goes first and one moving down last, so that the min is never
+            // blocked by its own max (and neither ever passes the other).
+            if (high + 1 < edges.size() && before(edges[high + 1], edges[high])) {
+                sortUp(axis, high);
+            }
+            if (low > 0 && before(edges[low], edges[low - 1])) {
+                sortDown(axis, low);
+            } else if (before(edges[low + 1], edges[low])) {
+                sortUp(axis, low);
+            }
+            const std::uint32_t max = at_[id][2 * axis + 1];
+            if (before(edges[max], edges[max - 1])) {
+                sortDown(axis, max);
+            }
+        }
     }
 
     /// Insertion with a hole: the endpoint at `at` moves down past every endpoint it now
@@ -520,7 +666,10 @@ class SweepAndPrune {
 
     std::array<std::vector<Endpoint>, D> axes_;
     std::vector<State> state_;
-    std::vector<Box> boxes_;  ///< every object's box (its endpoints' values, once sorted)
+    std::vector<Box> boxes_;           ///< every object's box (its endpoints' values, once sorted)
+    std::vector<Box> next_;            ///< a moved object's box, applied at the next maintain()
+    std::vector<std::uint8_t> dirty_;  ///< 1: in moved_
+    std::vector<ObjectId> moved_;      ///< objects moved since the last maintain()
     std::vector<Positions> at_;
     std::vector<std::uint32_t> pendingAt_;  ///< index in pending_, or kSettled
     std::vector<ObjectId> pending_;
@@ -532,6 +681,8 @@ class SweepAndPrune {
     std::size_t dead_ = 0;
     std::size_t swaps_ = 0;
     std::size_t changesRecorded_ = 0;
+    std::size_t batchedSearches_ = 0;
+    std::size_t oneByOneSearches_ = 0;
 };
 
 }  // namespace kolize
