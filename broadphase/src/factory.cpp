@@ -101,7 +101,6 @@ std::unique_ptr<btBroadphaseInterface> makeBroadphase(std::string_view name,
     if (name == "auto") {
         AutoSettings automatic;
         automatic.cells = settings.cells;
-        automatic.segmentTrees = settings.segmentTrees;
         return std::make_unique<CoreBroadphase<AutoCore<3, btScalar>>>(std::string(name), settings,
                                                                        automatic);
     }

@@ -1,20 +1,22 @@
 #pragma once
 /// \file
 /// AutoCore<D, Scalar>: the core of broadphase "auto". It holds one of kolize's cores at a
-/// time (grid, spatial-hash, segment-trees, sweep) and picks it from what it measures of
-/// the scene (SceneMeasure, filled in by the adapter): object count, how many move and how
-/// far against their size, the spread of sizes, how crowded the cells would be, and the rays and
-/// box queries per frame. When the scene changes it switches: the adapter rebuilds the new core
-/// from the current boxes without touching the pair cache (no pair lost, no cached algorithm
-/// freed).
+/// time (grid, spatial-hash, sweep) and picks it from what it measures of the scene
+/// (SceneMeasure, filled in by the adapter): object count, how many move and how far against
+/// their size, how crowded the cells would be, how many endpoints a sorted sweep would pass,
+/// and the rays and box queries per frame. When the scene changes it switches: the adapter
+/// rebuilds the new core from the current boxes without touching the pair cache (no pair
+/// lost, no cached algorithm freed).
 ///
 /// The rules (measured with kolize-demo over the scene registry, see README):
 /// - under 64 objects: sweep, whatever they do (the registry's small worlds, 5-40 bodies,
 ///   cost it 0.0006-0.003 ms per frame, the other cores up to 6x that);
-/// - sizes spread over more than 30x (90th over 10th percentile): segment-trees, whose cost
-///   does not depend on one cell size or on endpoints of small boxes passing large ones
-///   (mixed-sizes, replayed: segment-trees 0.47x of sap-noray, sweep 1.8x, spatial-hash
-///   3.7x);
+/// - the spread of sizes does not decide. Until the sweep applied many moves in one pass per
+///   axis, sizes spread over 30x took the segment trees (mixed-sizes: the sweep's one-by-one
+///   updates made large boxes' ends pass many small ones'); now, replayed over 300 frames,
+///   mixed-sizes costs the sweep 0.014 ms, the grid 0.068 and the segment trees 0.073, and in
+///   two synthetic streams of sizes spread 1e4x moving fast the sweep or the grid was fastest,
+///   never the segment trees: auto no longer holds them;
 /// - many long rays (at least max(16, N/64) per frame, reaching 8 box sizes or more; CCD's
 ///   short sweeps do not count): spatial-hash, whose ray walk visits few
 ///   cells and no empty ones (sweep tests every object per ray; measured on mixed-rays and
@@ -30,23 +32,27 @@
 ///   pair starts or stops overlapping, as in a stack or pyramid that does not fall
 ///   asleep): grid, whose fat boxes and pair certificates absorb the moves, where the
 ///   sweep's endpoints swap among the near-equal coordinates of a stack (pyramid, moving
-///   frames: grid 0.019 ms, sweep 0.080);
+///   frames replayed: grid 0.026-0.029 ms, sweep 0.064-0.068);
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
 ///   most Bullet worlds, resting or settling) in which a sorted sweep would swap much: the
 ///   estimated endpoints passed per moved object (SceneMeasure::swapsPerMove, known under
 ///   any core; while the sweep runs, its own count replaces the estimate) at least
 ///   30 x (1 + half the grid's crowding), under 0.1 pair changes per move: grid. Float
-///   coordinates far from the origin (offset-1e6: 50-75 passed, the grid 0.7x of the
-///   sweep's time) and boxes settling on a lattice of equal coordinates (pyramid, and
-///   bench-1000-stack's first frames) pass many equal endpoints that the grid's cells never
-///   order;
-/// - slow motion otherwise: sweep. (mixed-terrain, mixed-plane and offset-1e4 favour the
-///   grid over their first 96 frames, with 43-110 passed: counted under the sweep, that
-///   takes the grid at frame 32; the estimate there, from boxes that had fallen away from
-///   the sampled moves' places, was 18. They favour the sweep again from frame 96 on, which
-///   auto sees by frame 160.)
+///   coordinates far from the origin (offset-1e6: 56 passed, counted; the grid 0.8x of the
+///   sweep's time over 300 frames) and boxes settling on a lattice of equal coordinates
+///   (pyramid) pass many equal endpoints that the grid's cells never order;
+/// - slow motion otherwise: sweep. (mixed-terrain, mixed-plane and offset-1e4 passed 43-110
+///   per move in the sweep's old one-by-one updates, most of them ends of boxes falling with
+///   them that had not moved yet; applied in one pass, mixed-terrain counts 5-27 and the sweep
+///   takes half of the grid's time.)
 /// - faster motion in which a moved box passes under 4 endpoints (bodies flying apart, or
-///   falling together): sweep, whose cost does not grow with the distance a box goes;
+///   falling together): sweep, whose cost does not grow with the distance a box goes. The
+///   estimate under another core counts the order changes among a sample of one frame's
+///   moves, and the moves against the boxes that stayed only for the share that stayed:
+///   escape's bodies flying apart, set against every box where it stood, seemed to pass
+///   2-10 (the grid until frame 160, at 3x the sweep's time); among each other they pass
+///   about 1 (the sweep from frame 32). Thesis A's fast cubes pass 8: the grid, at half the
+///   sweep's time;
 /// - faster motion otherwise, and the dense grid would crowd (its cells, enlarged to fit its
 ///   budget of cells per object over the objects' bounds, would put more than 16 + 2x as
 ///   many other objects beside an object as the sparse cells do: a cluster in a large space, as the
@@ -65,7 +71,6 @@
 
 #include <kolize/broadphase/aabb.h>
 #include <kolize/broadphase/cell_grid.h>
-#include <kolize/broadphase/segment_tree_set.h>
 #include <kolize/broadphase/sweep_and_prune.h>
 
 #include <algorithm>
@@ -94,7 +99,6 @@ struct SceneMeasure {
     /// ends), estimated under any core: a sample of the moves against the endpoints of a
     /// sample of the boxes, scaled to all of them.
     double swapsPerMove = 0;
-    double sizeSpread = 1;  ///< 90th over 10th percentile of box sizes (sampled)
     double medianSize = 0;  ///< median largest extent of the sampled boxes
     /// Centres of a sample of the boxes (at most 1024, planes and boxes over 1e6 left out).
     std::vector<std::array<double, 3>> centres;
@@ -106,7 +110,6 @@ struct SceneMeasure {
 /// Settings of broadphase "auto": the settings of the cores it may use.
 struct AutoSettings {
     CellGridSettings cells;
-    SegmentTreeSettings segmentTrees;
     /// Evaluate every this many pair searches (default 32).
     int evaluateEvery = 32;
 };
@@ -116,13 +119,10 @@ class AutoCore {
   public:
     using Box = Aabb<D, Scalar>;
     using Settings = AutoSettings;
-    enum class Kind : std::uint8_t { Grid, SpatialHash, SegmentTrees, Sweep };
+    enum class Kind : std::uint8_t { Grid, SpatialHash, Sweep };
 
     explicit AutoCore(const Settings& settings = {})
-        : settings_(settings),
-          grid_(settings.cells),
-          hash_(settings.cells),
-          trees_(noKeptSet(settings.segmentTrees)) {}
+        : settings_(settings), grid_(settings.cells), hash_(settings.cells) {}
 
     static const char* kindName(Kind kind) {
         switch (kind) {
@@ -130,8 +130,6 @@ class AutoCore {
                 return "grid";
             case Kind::SpatialHash:
                 return "spatial-hash";
-            case Kind::SegmentTrees:
-                return "segment-trees";
             case Kind::Sweep:
                 return "sweep";
         }
@@ -196,7 +194,6 @@ class AutoCore {
     void switchTo(Kind kind, const std::string& why) {
         grid_ = UniformGrid<D, Scalar>(settings_.cells);
         hash_ = SpatialHash<D, Scalar>(settings_.cells);
-        trees_ = SegmentTreeSet<D, Scalar>(noKeptSet(settings_.segmentTrees));
         sweep_ = SweepAndPrune<D, Scalar>();
         swapsSeen_ = 0;
         updatesSeen_ = updates_;
@@ -246,8 +243,7 @@ class AutoCore {
         dispatch([&](const auto& core) { core.validate(); });
     }
     std::size_t memoryBytes() const {
-        return grid_.memoryBytes() + hash_.memoryBytes() + trees_.memoryBytes() +
-               sweep_.memoryBytes();
+        return grid_.memoryBytes() + hash_.memoryBytes() + sweep_.memoryBytes();
     }
 
   private:
@@ -295,11 +291,6 @@ class AutoCore {
     static constexpr double kJitterFatExits = 0.01;
     static constexpr double kJitterPairChanges = 0.002;
 
-    static SegmentTreeSettings noKeptSet(SegmentTreeSettings settings) {
-        settings.incremental = false;  // the adapter keeps the candidate pairs itself
-        return settings;
-    }
-
     Kind rule(const SceneMeasure& m) {
         const double n = double(m.objects);
         waiting_ = false;
@@ -307,11 +298,6 @@ class AutoCore {
             ruleReason_ = std::to_string(m.objects) +
                           " objects: a sweep over so few costs least, whatever they do";
             return Kind::Sweep;
-        }
-        if (m.sizeSpread > 30) {
-            ruleReason_ = "sizes spread " + shortNumber(m.sizeSpread) +
-                          "x: segment trees do not depend on one cell size";
-            return Kind::SegmentTrees;
         }
         if (m.raysPerFrame >= std::max(16.0, n / 64) && m.rayLength >= kLongRay) {
             ruleReason_ = std::to_string(int(m.raysPerFrame)) + " rays per frame, " +
@@ -381,7 +367,7 @@ class AutoCore {
             return Kind::SpatialHash;
         }
         ruleReason_ = "fast motion (" + shortNumber(m.relativeMotion) +
-                      " of their size per frame), even sizes, spread out: one cell size fits";
+                      " of their size per frame), spread out: one cell size fits";
         return Kind::Grid;
     }
 
@@ -470,9 +456,6 @@ class AutoCore {
             case Kind::SpatialHash:
                 f(self.hash_);
                 return;
-            case Kind::SegmentTrees:
-                f(self.trees_);
-                return;
             case Kind::Sweep:
                 f(self.sweep_);
                 return;
@@ -490,7 +473,6 @@ class AutoCore {
     Settings settings_;
     UniformGrid<D, Scalar> grid_;
     SpatialHash<D, Scalar> hash_;
-    SegmentTreeSet<D, Scalar> trees_;
     SweepAndPrune<D, Scalar> sweep_;
     Kind kind_ = Kind::Grid;
     Kind pending_ = Kind::Grid;

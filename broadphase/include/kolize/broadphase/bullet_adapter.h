@@ -425,9 +425,20 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     };
     std::vector<SampledMove> sampledMoves_;  ///< a uniform sample of the sampled moves
     std::uint64_t moveSampleState_ = 0x9e3779b97f4a7c15u;  ///< the sample's fixed-seed generator
-    /// Endpoints a sorted sweep would pass per move, estimated from sampledMoves_ against
-    /// the sampled boxes' endpoints (fills SceneMeasure::swapsPerMove).
-    double estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots) const;
+    /// Endpoints a sorted sweep would pass per move: the moved objects passing each other,
+    /// from the order changes within a sample of one frame's moves (movingSwaps_), plus the
+    /// sampled moves against the sampled boxes' endpoints for the share of objects that did
+    /// not move (fills SceneMeasure::swapsPerMove).
+    double estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots,
+                                double movedPerFrame) const;
+    /// At the end of a sampled frame: the order changes among frameMoves_ (a uniform sample
+    /// of that frame's moves) scaled to all of the frame's moves, into movingSwaps_.
+    void countMovingSwaps();
+    static constexpr std::size_t kFrameSampleMoves = 64;
+    std::vector<SampledMove> frameMoves_;
+    double frameMoveCount_ = 0;   ///< moves in the sampled frame under way
+    double movingSwaps_ = 0;      ///< estimated swaps among moved objects, sampled frames
+    double movingSwapMoves_ = 0;  ///< the moves of the frames counted in movingSwaps_
 };
 
 /// A btBroadphaseInterface over a kolize core. `Core` provides insert / update / remove,
