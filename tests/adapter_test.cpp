@@ -1052,8 +1052,8 @@ TEST(Auto, AWorldThatStartsStillIsJudgedByItsFirstMotion) {
 
 // The first decision, from two frames, is a guess: dense-pile's bodies fall fast for their
 // first frames (the grid) and then settle slowly, where the sweep takes a fifth of the grid's
-// time. The first decision made from a full window (the 30 frames before frame 32) takes
-// effect at once, not only after winning a second evaluation at frame 64.
+// time. The first decision made from a full window (frames 2-17, evaluated at frame 18)
+// takes effect at once, not only after winning a second evaluation.
 TEST(Auto, TheFirstFullWindowCorrectsAGuessFromTwoFrames) {
     auto broadphase = makeBroadphase("auto");
     auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
@@ -1084,8 +1084,12 @@ TEST(Auto, TheFirstFullWindowCorrectsAGuessFromTwoFrames) {
         const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
         ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
         const std::string description = adapter.coreDescription();
-        if (frame == 4) {
-            EXPECT_EQ(description.rfind("auto: grid (fast motion", 0), 0u) << description;
+        if (frame == 4 || frame == 17) {
+            EXPECT_EQ(description.rfind("auto: grid (fast motion", 0), 0u)
+                << "frame " << frame << ": " << description;
+        }
+        if (frame == 18) {
+            EXPECT_EQ(description.rfind("auto: sweep (slow motion", 0), 0u) << description;
         }
     }
     adapter.validate();

@@ -21,10 +21,10 @@ namespace kolize {
 
 /// Makes the broadphase called `name`. Names (see broadphaseNames()):
 /// - "auto": for a scene you do not know: measures it (object count, share and speed of the
-///   moving objects, size spread, cell crowding, rays per frame) every 32 frames and uses the
-///   core that suits it (sweep, grid, spatial-hash or segment-trees), switching when the scene
-///   changes without losing a pair (BroadphaseAdapter::coreDescription() says what it chose and
-///   why).
+///   moving objects, cell crowding, endpoints a sorted sweep would pass, rays per frame) every
+///   32 frames and uses the core that suits it (sweep, grid or spatial-hash), switching when the
+///   scene changes without losing a pair (BroadphaseAdapter::coreDescription() says what it chose
+///   and why).
 /// - "grid": uniform grid (thesis method A): a dense array of cells over a region chosen
 ///   from the objects, with an overflow set for huge and outside objects. Best for
 ///   objects spread evenly. Settings: settings.cells.

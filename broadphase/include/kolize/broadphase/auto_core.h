@@ -64,8 +64,9 @@
 /// - faster motion otherwise: grid.
 /// The first decision (after two pair searches, or later if nothing moved) switches at once:
 /// the starting core (grid) was nobody's choice. So does the first decision made from a full
-/// window (16 frames or more; the first is often made from two): a pyramid that jitters is
-/// seen as such from its first full window on. After that a choice must win two evaluations
+/// window (16 frames or more; the first is often made from two; the adapter evaluates at
+/// frame 18, after frames 2-17, and then every 32): a pyramid that jitters is seen as such
+/// from its first full window on. After that a choice must win two evaluations
 /// in a row (every 32 frames), and every choice after the second switch stands at least 128
 /// frames, so a scene on a threshold does not flip back and forth.
 

@@ -546,6 +546,8 @@ class CoreBroadphase final : public BroadphaseAdapter {
 
   private:
     static constexpr bool kAuto = std::is_same_v<Core, AutoCore<3, btScalar>>;
+    /// The evaluation after the first full window of "auto" (see chooseCore).
+    static constexpr std::size_t kFirstWindowEnd = 18;
     /// A core whose tracksOverlaps() may be true provides drainChanges.
     template <class C>
     static constexpr auto tracks(int)
@@ -571,8 +573,11 @@ class CoreBroadphase final : public BroadphaseAdapter {
             const std::size_t frame = stats().frames;
             const std::size_t every = std::size_t(std::max(1, coreSettings_.evaluateEvery));
             // Undecided, it looks again after each sampled frame that saw a move, a ray or a
-            // query (a world at rest from the start pays only the regular evaluations).
-            const bool due = frame == 2 || frame % every == 0 ||
+            // query (a world at rest from the start pays only the regular evaluations). Frame
+            // 18 closes the first full window (frames 2-17, two sampled frames): the guess
+            // from two frames is corrected there, not at frame 32 (a pyramid that jitters
+            // spent frames 2-31 on the sweep at 2.5x the grid's time).
+            const bool due = frame == 2 || frame == kFirstWindowEnd || frame % every == 0 ||
                              (core_.undecided() && followsSampledFrame(frame) && measuredAny());
             if (frame == 0 || !due) {
                 return;
