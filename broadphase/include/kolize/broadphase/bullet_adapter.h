@@ -434,7 +434,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// At the end of a sampled frame: the order changes among frameMoves_ (a uniform sample
     /// of that frame's moves) scaled to all of the frame's moves, into movingSwaps_.
     void countMovingSwaps();
-    static constexpr std::size_t kFrameSampleMoves = 64;
+    static constexpr std::size_t kFrameSampleMoves = 32;
     std::vector<SampledMove> frameMoves_;
     double frameMoveCount_ = 0;   ///< moves in the sampled frame under way
     double movingSwaps_ = 0;      ///< estimated swaps among moved objects, sampled frames
