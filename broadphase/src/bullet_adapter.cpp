@@ -408,6 +408,19 @@ void BroadphaseAdapter::startShadow(ObjectId slot) {
     }
 }
 
+namespace {
+
+/// A number below `bound` from the generator's high 32 bits, by a multiply and a shift (a
+/// 64-bit division per sampled move cost more than the rest of the sample).
+std::size_t below(std::uint64_t state, std::size_t bound) {
+    if (bound > 0xffffffffu) {
+        return std::size_t(state % bound);
+    }
+    return std::size_t(((state >> 32) * std::uint64_t(bound)) >> 32);
+}
+
+}  // namespace
+
 void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     const Box& from = boxes_[slot];
     // Would a fat box have held this move? With fat boxes, it is the core box; while the
@@ -433,7 +446,7 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
         sampledMoves_.push_back({from, to});
     } else {
         moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
-        const std::size_t at = std::size_t((moveSampleState_ >> 33) % seen);
+        const std::size_t at = below(moveSampleState_, seen);
         if (at < kSwapSampleMoves) {
             sampledMoves_[at] = {from, to};
         }
@@ -444,7 +457,7 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
         frameMoves_.push_back({from, to});
     } else {
         moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
-        const std::size_t at = std::size_t((moveSampleState_ >> 33) % std::size_t(frameMoveCount_));
+        const std::size_t at = below(moveSampleState_, std::size_t(frameMoveCount_));
         if (at < kFrameSampleMoves) {
             frameMoves_[at] = {from, to};
         }
