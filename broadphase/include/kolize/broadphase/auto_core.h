@@ -331,15 +331,18 @@ class AutoCore {
             const std::string motion = "slow motion (" + std::to_string(int(m.movedPerFrame)) +
                                        " objects moved per frame, by " +
                                        shortNumber(m.relativeMotion) + " of their size)";
-            const double crowd = crowding(m, denseCell(m, sparseCell(m)));
+            // The crowding (a sort of the sampled centres' cells) only matters from kManySwaps
+            // on: below, the sweep whatever it is.
+            const bool many = m.swapsPerMove >= kManySwaps;
+            const double crowd = many ? crowding(m, denseCell(m, sparseCell(m))) : 0;
             const std::string swaps =
                 shortNumber(m.swapsPerMove) +
-                (swapsCounted_ ? " endpoints passed per moved object (counted); "
-                               : " endpoints passed per moved object; ") +
-                shortNumber(crowd) + " others in an object's grid cell";
+                (swapsCounted_ ? " endpoints passed per moved object (counted)"
+                               : " endpoints passed per moved object") +
+                (many ? "; " + shortNumber(crowd) + " others in an object's grid cell" : "");
             // The first evaluation's pair changes are the world's first pairs, not motion.
             const double pairChanges = evaluations_ > 0 ? m.pairChangesPerMove : 0;
-            if (m.swapsPerMove >= kManySwaps * (1 + crowd / 2) &&
+            if (many && m.swapsPerMove >= kManySwaps * (1 + crowd / 2) &&
                 pairChanges < kManySwapsPairChanges) {
                 ruleReason_ = motion + ", but sorted endpoints would swap much (" + swaps +
                               "): the grid's cells and fat boxes do not see the order";

@@ -400,7 +400,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     static bool followsSampledFrame(std::size_t frame) { return frame % kMotionSampleEvery == 2; }
     /// Whether a move, ray or box query was measured since the last measure.
     bool measuredAny() const {
-        return measuredChanges_ > 0 || measuredRays_ > 0 || measuredQueries_ > 0;
+        return measuredMoves_ > 0 || measuredRays_ > 0 || measuredQueries_ > 0;
     }
 
   private:
@@ -410,8 +410,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     bool measuring_ = false;
     bool sampleMotion_ = false;  ///< this frame's setAabb calls feed the motion measure
     bool forceFullSearch_ = false;
-    double measuredChanges_ = 0, measuredMotion_ = 0, measuredRays_ = 0, measuredQueries_ = 0,
-           measuredRayLength_ = 0, measuredFatExits_ = 0;
+    /// measuredMoves_: every move in the sampled frames; measuredChanges_: those looked at.
+    double measuredChanges_ = 0, measuredMoves_ = 0, measuredMotion_ = 0, measuredRays_ = 0,
+           measuredQueries_ = 0, measuredRayLength_ = 0, measuredFatExits_ = 0;
     std::size_t measuredFrames_ = 0, measuredMotionFrames_ = 0;
     std::size_t pairChangesSeen_ = 0;  ///< pairsAdded + pairsRemoved at the last measure
     /// At most this many sampled moves per measure are kept for the swap estimate, and at
@@ -436,7 +437,12 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     void countMovingSwaps();
     static constexpr std::size_t kFrameSampleMoves = 32;
     std::vector<SampledMove> frameMoves_;
-    double frameMoveCount_ = 0;   ///< moves in the sampled frame under way
+    double frameMoveCount_ = 0;  ///< moves in the sampled frame under way
+    double frameExamined_ = 0;   ///< of those, the moves looked at (slot % sampleStride_ == 0)
+    /// A sampled frame looks at the moves of the slots divisible by this (about
+    /// kExaminedMoves of the live objects; set at the end of each sampled frame).
+    std::size_t sampleStride_ = 1;
+    static constexpr std::size_t kExaminedMoves = 256;
     double movingSwaps_ = 0;      ///< estimated swaps among moved objects, sampled frames
     double movingSwapMoves_ = 0;  ///< the moves of the frames counted in movingSwaps_
 };
