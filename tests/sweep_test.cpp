@@ -176,20 +176,25 @@ TEST(SweepTracking, DrainedChangesKeepTheExactPairsUnderMovesJitterAndReusedIds)
     }
 }
 
-// A stack's layer: 64 unit boxes side by side whose lows and highs are equal but for a
-// jitter of a few ulps, all moved every frame. One insertion pass per axis reorders the
-// tied endpoints; the drained changes must still keep the exact pairs, and the passes must
-// swap only what changed order (boxes translated together swap nothing).
-TEST(SweepTracking, ABatchOfTiedJitteringEndpointsKeepsTheExactPairs) {
-    std::mt19937 rng(7);
-    std::printf("tied jitter, seed 7\n");
-    kolize::SweepAndPrune<3, float> core;
+/// A stack's layer: 64 unit boxes, 8 x 8 side by side, touching exactly; inserted in `core`.
+std::vector<Box> unitLayer(kolize::SweepAndPrune<3, float>& core) {
     std::vector<Box> boxes;
     for (int i = 0; i < 64; ++i) {
         const float x = float(i % 8), z = float(i / 8);
         boxes.push_back(Box{{x, 0, z}, {x + 1, 1, z + 1}});
         core.insert(kolize::ObjectId(i), boxes.back());
     }
+    return boxes;
+}
+
+// A stack's layer whose lows and highs are equal but for a jitter of a few ulps, all moved
+// every frame. One insertion pass per axis reorders the tied endpoints; the drained changes
+// must still keep the exact pairs.
+TEST(SweepTracking, ABatchOfTiedJitteringEndpointsKeepsTheExactPairs) {
+    std::mt19937 rng(7);
+    std::printf("tied jitter, seed 7\n");
+    kolize::SweepAndPrune<3, float> core;
+    std::vector<Box> boxes = unitLayer(core);
     std::set<Pair> tracked;
     auto drain = [&] {
         core.maintain();
@@ -244,12 +249,7 @@ TEST(SweepTracking, ABatchOfTiedJitteringEndpointsKeepsTheExactPairs) {
 // touching exactly, all translated by a quarter (exact in float) every frame.
 TEST(SweepTracking, ABatchTranslatedTogetherSwapsNothing) {
     kolize::SweepAndPrune<3, float> core;
-    std::vector<Box> boxes;
-    for (int i = 0; i < 64; ++i) {
-        const float x = float(i % 8), z = float(i / 8);
-        boxes.push_back(Box{{x, 0, z}, {x + 1, 1, z + 1}});
-        core.insert(kolize::ObjectId(i), boxes.back());
-    }
+    std::vector<Box> boxes = unitLayer(core);
     core.maintain();
     std::size_t pairs = 0;
     core.drainChanges([&](kolize::ObjectId, kolize::ObjectId) { ++pairs; });
