@@ -32,9 +32,10 @@ namespace kolize {
 ///   unbounded. Settings: settings.cells.
 /// - "spatial-hash": the same sparse cells in a hash table; unbounded.
 /// - "sweep": exact incremental sweep and prune: sorted box endpoints per axis, updated by
-///   swaps, so a frame costs O(moved objects + endpoint swaps). Best where objects move a
-///   little each frame (piles, stacks, resting worlds); box queries scan one axis and rays
-///   test every object.
+///   swaps at the pair search (one insertion pass per axis when many objects moved), so a
+///   frame costs O(moved objects + endpoint swaps). Best where objects move a little each
+///   frame (piles, stacks, falling and settling worlds, any sizes); box queries scan one axis
+///   and rays test every object.
 /// - "brute-force": kolize's exact reference (tests every pair; O(N^2) per frame).
 /// - "segment-trees": the thesis's set of segment trees, one per axis (settings.segmentTrees).
 /// - "range-tree": the thesis's range tree, one segment tree with sorted node lists
