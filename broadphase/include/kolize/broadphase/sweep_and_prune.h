@@ -244,7 +244,7 @@ class SweepAndPrune {
     }
 
     std::size_t size() const { return size_; }
-    /// Endpoint swaps so far (the work of update()), and changed pairs recorded.
+    /// Endpoint swaps so far (the work of applying moves), and changed pairs recorded.
     std::size_t swaps() const { return swaps_; }
     std::size_t changesRecorded() const { return changesRecorded_; }
     /// Pair searches whose moves were applied in one insertion pass per axis, and those
