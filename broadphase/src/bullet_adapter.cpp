@@ -449,25 +449,22 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     // A uniform sample of the moves (reservoir; a fixed-seed generator, so a replayed
     // stream gets the same sample and the same choices).
     const std::size_t seen = std::size_t(measuredChanges_);
-    if (sampledMoves_.size() < kSwapSampleMoves) {
-        sampledMoves_.push_back({from, to});
-    } else {
-        moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
-        const std::size_t at = below(moveSampleState_, seen);
-        if (at < kSwapSampleMoves) {
-            sampledMoves_[at] = {from, to};
-        }
-    }
+    keepSample(sampledMoves_, kSwapSampleMoves, seen, {from, to});
     // And a uniform sample of this frame's moves, to count how they pass each other.
     frameExamined_ += 1;
-    if (frameMoves_.size() < kFrameSampleMoves) {
-        frameMoves_.push_back({from, to});
-    } else {
-        moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
-        const std::size_t at = below(moveSampleState_, std::size_t(frameExamined_));
-        if (at < kFrameSampleMoves) {
-            frameMoves_[at] = {from, to};
-        }
+    keepSample(frameMoves_, kFrameSampleMoves, std::size_t(frameExamined_), {from, to});
+}
+
+void BroadphaseAdapter::keepSample(std::vector<SampledMove>& sample, std::size_t capacity,
+                                   std::size_t seen, const SampledMove& move) {
+    if (sample.size() < capacity) {
+        sample.push_back(move);
+        return;
+    }
+    moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
+    const std::size_t at = below(moveSampleState_, seen);
+    if (at < capacity) {
+        sample[at] = move;
     }
 }
 

@@ -432,6 +432,10 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// not move (fills SceneMeasure::swapsPerMove).
     double estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots,
                                 double movedPerFrame) const;
+    /// Reservoir sampling: `move`, the seen-th of its kind, replaces a random member of
+    /// `sample` (at most `capacity`) with probability capacity / seen.
+    void keepSample(std::vector<SampledMove>& sample, std::size_t capacity, std::size_t seen,
+                    const SampledMove& move);
     /// At the end of a sampled frame: the order changes among frameMoves_ (a uniform sample
     /// of that frame's moves) scaled to all of the frame's moves, into movingSwaps_.
     void countMovingSwaps();
