@@ -418,7 +418,7 @@ class SweepAndPrune {
             }
             for (int axis = 0; axis < D; ++axis) {
                 if (changed[axis]) {
-                    insertionPass(axis);
+                    insertionPass<0>(axis);
                 }
             }
             ++batchedSearches_;
@@ -430,7 +430,17 @@ class SweepAndPrune {
     /// at their old places (see applyMoves). The positions on this axis are stale during
     /// the pass (the overlap tests read the other axes only) and rewritten over the range
     /// that changed.
-    void insertionPass(int axis) {
+    template <int kFrom>
+    void insertionPass(int which) {
+        // The axis as a constant: the overlap test then reads the other axes' positions of
+        // the moving endpoint from registers.
+        if constexpr (kFrom + 1 < D) {
+            if (which != kFrom) {
+                insertionPass<kFrom + 1>(which);
+                return;
+            }
+        }
+        constexpr int axis = kFrom;
         // Raw pointers: the arrays do not change size here, and the compiler need not reload
         // them after every store or recorded change.
         Endpoint* const edges = axes_[axis].data();
@@ -448,7 +458,14 @@ class SweepAndPrune {
             std::size_t to = i;
             do {
                 const Endpoint next = edges[to - 1];
-                if (next.isMax() != isMax && overlapsOnOtherAxes(mine, at[next.id()], axis)) {
+                const Positions& theirs = at[next.id()];
+                // Branch-free until the rare outcome, as in sortAway.
+                bool overlap = next.isMax() != isMax;
+                for (int a = 0; a < D; ++a) {
+                    overlap &= a == axis || (mine[2 * a + 1] >= theirs[2 * a]) &
+                                                (theirs[2 * a + 1] >= mine[2 * a]);
+                }
+                if (overlap) {
                     changes_.push_back(Change{id, next.id()});
                     ++changesRecorded_;
                 }
