@@ -426,7 +426,7 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     // large world cost 30 ns per move when every move was examined, 4x an ordinary frame).
     measuredMoves_ += 1;
     frameMoveCount_ += 1;
-    if (slot % sampleStride_ != 0) {
+    if ((slot & sampleMask_) != 0) {
         return;
     }
     const Box& from = boxes_[slot];
@@ -446,6 +446,11 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     }
     measuredChanges_ += 1;
     measuredMotion_ += std::min(1e3, motion(from, to) / std::max(size, 1e-30));
+    if (coreTracksOverlaps_) {
+        // The tracking core (auto's sweep) counts its own swaps, and auto takes that count
+        // (AutoCore::takeMeasure): the moves are not sampled for an estimate.
+        return;
+    }
     // A uniform sample of the moves (reservoir; a fixed-seed generator, so a replayed
     // stream gets the same sample and the same choices).
     const std::size_t seen = std::size_t(measuredChanges_);
@@ -506,8 +511,15 @@ void BroadphaseAdapter::countMovingSwaps() {
     movingSwapMoves_ += frameMoveCount_;
     frameMoves_.clear();
     frameMoveCount_ = frameExamined_ = 0;
-    // The next sampled frame looks at about kExaminedMoves of the objects.
-    sampleStride_ = std::max<std::size_t>(1, (liveCount_ - parkedCount_) / kExaminedMoves);
+    // The next sampled frame looks at about kExaminedMoves of the objects (the stride the
+    // power of two at or above the quotient: from half of them to all).
+    const std::size_t stride =
+        std::max<std::size_t>(1, (liveCount_ - parkedCount_) / kExaminedMoves);
+    std::size_t power = 1;
+    while (power < stride) {
+        power *= 2;
+    }
+    sampleMask_ = power - 1;
 }
 
 double BroadphaseAdapter::estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots,

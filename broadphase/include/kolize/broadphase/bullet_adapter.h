@@ -442,10 +442,12 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     static constexpr std::size_t kFrameSampleMoves = 32;
     std::vector<SampledMove> frameMoves_;
     double frameMoveCount_ = 0;  ///< moves in the sampled frame under way
-    double frameExamined_ = 0;   ///< of those, the moves looked at (slot % sampleStride_ == 0)
-    /// A sampled frame looks at the moves of the slots divisible by this (about
-    /// kExaminedMoves of the live objects; set at the end of each sampled frame).
-    std::size_t sampleStride_ = 1;
+    double frameExamined_ = 0;   ///< of those, the moves looked at (slot & sampleMask_ == 0)
+    /// A sampled frame looks at the moves of the slots divisible by sampleMask_ + 1, a power
+    /// of two (about kExaminedMoves of the live objects, at least half as many; set at the
+    /// end of each sampled frame): a mask, where a division cost more than the rest of
+    /// noteMotion for the moves not looked at.
+    std::size_t sampleMask_ = 0;
     static constexpr std::size_t kExaminedMoves = 256;
     double movingSwaps_ = 0;      ///< estimated swaps among moved objects, sampled frames
     double movingSwapMoves_ = 0;  ///< the moves of the frames counted in movingSwaps_
