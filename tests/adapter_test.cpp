@@ -1233,6 +1233,60 @@ TEST(Auto, AFewObjectsTakeTheSweep) {
     EXPECT_EQ(description.rfind("auto: sweep (9 objects", 0), 0u) << description;
 }
 
+/// The number in "(<number> objects moved per frame" of a core description.
+int movedInDescription(const std::string& description) {
+    const std::size_t at = description.find(" objects moved per frame");
+    if (at == std::string::npos) {
+        return -1;
+    }
+    const std::size_t start = description.rfind('(', at);
+    return std::stoi(description.substr(start + 1, at - start - 1));
+}
+
+// auto counts every move (every setAabb that changed a box: under the grid mostly moves
+// inside fat boxes, under the sweep core updates) and looks at a class of the moves spread
+// over the frames. 1200 unit boxes apart from each other, all sent to setAabb every frame;
+// 240 of them (every fifth) jitter by a thousandth of their size for 40 frames (resting
+// jitter: the grid, chosen at frame 18), then drift a tenth of their size per frame (slow
+// motion passing few endpoints: the sweep, once 128 frames have passed since the last
+// switch, at frame 160). Both descriptions must count exactly 240 moves per frame.
+TEST(Auto, CountsEveryMoveUnderTheGridAndUnderTheSweep) {
+    auto broadphase = makeBroadphase("auto");
+    auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+    std::vector<btScalar> xs;
+    for (int i = 0; i < 1200; ++i) {
+        xs.push_back(btScalar(3 * i));
+    }
+    BoxMap boxes;
+    const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, xs);
+    constexpr int kJitterFrames = 40, kFrames = 161;
+    std::vector<std::string> evaluated;
+    for (int frame = 0; frame < kFrames; ++frame) {
+        for (std::size_t i = 0; i < proxies.size(); ++i) {
+            ProxyBox& box = boxes[proxies[i]];
+            if (i % 5 == 2) {
+                const btScalar x = frame < kJitterFrames
+                                       ? xs[i] + btScalar(frame % 2 == 0 ? 0.001 : -0.001)
+                                       : xs[i] + btScalar(0.1) * btScalar(frame - kJitterFrames);
+                box.aabbMin.setX(x);
+                box.aabbMax.setX(x + 1);
+            }
+            broadphase->setAabb(proxies[i], box.aabbMin, box.aabbMax, nullptr);
+        }
+        const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+        ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+        if (frame == 18 || frame == 160) {
+            evaluated.push_back(adapter.coreDescription());
+        }
+    }
+    adapter.validate();
+    ASSERT_EQ(evaluated.size(), 2u);
+    EXPECT_EQ(evaluated[0].rfind("auto: grid (resting, jittering", 0), 0u) << evaluated[0];
+    EXPECT_EQ(movedInDescription(evaluated[0]), 240) << evaluated[0];
+    EXPECT_EQ(evaluated[1].rfind("auto: sweep (slow motion", 0), 0u) << evaluated[1];
+    EXPECT_EQ(movedInDescription(evaluated[1]), 240) << evaluated[1];
+}
+
 // Found by the fuzzer (seed 1, shrunk): "auto" switched to sweep after two searches of an
 // empty world; resetPool then restarted its core on the grid while the adapter still took it
 // for a core that tracks overlaps, and the next pair of overlapping proxies was never found.

@@ -306,7 +306,7 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
-        if (sampleMotion_) {
+        if ((slot & spreadMask_) == spreadClass_) {
             noteMotion(slot, box);
         }
         if (coreTracksOverlaps_) {
@@ -422,13 +422,8 @@ std::size_t below(std::uint64_t state, std::size_t bound) {
 }  // namespace
 
 void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
-    // Every move counts; the slots of one stride class are looked at (a sampled frame of a
-    // large world cost 30 ns per move when every move was examined, 4x an ordinary frame).
-    measuredMoves_ += 1;
-    frameMoveCount_ += 1;
-    if ((slot & sampleMask_) != 0) {
-        return;
-    }
+    // Called for the slots chosen for this frame (chooseExamined); every move is counted at
+    // the search.
     const Box& from = boxes_[slot];
     // Would a fat box have held this move? With fat boxes, it is the core box; while the
     // core tracks overlaps, fat_ is a shadow kept up to date only here (in sampled frames,
@@ -455,9 +450,11 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     // stream gets the same sample and the same choices).
     const std::size_t seen = std::size_t(measuredChanges_);
     keepSample(sampledMoves_, kSwapSampleMoves, seen, {from, to});
-    // And a uniform sample of this frame's moves, to count how they pass each other.
-    frameExamined_ += 1;
-    keepSample(frameMoves_, kFrameSampleMoves, std::size_t(frameExamined_), {from, to});
+    if (countSwapsThisFrame_) {
+        // And a uniform sample of this frame's moves, to count how they pass each other.
+        frameExamined_ += 1;
+        keepSample(frameMoves_, kFrameSampleMoves, std::size_t(frameExamined_), {from, to});
+    }
 }
 
 void BroadphaseAdapter::keepSample(std::vector<SampledMove>& sample, std::size_t capacity,
@@ -473,7 +470,44 @@ void BroadphaseAdapter::keepSample(std::vector<SampledMove>& sample, std::size_t
     }
 }
 
-void BroadphaseAdapter::countMovingSwaps() {
+void BroadphaseAdapter::chooseExamined(std::size_t frames) {
+    spreadMask_ = 0;
+    spreadClass_ = 1;  // none
+    countSwapsThisFrame_ = false;
+    if (!measuring_ || (frames > 1 && frames < kMotionSampleEvery)) {
+        return;
+    }
+    if (frames == 1 || frames % kMotionSampleEvery == 0) {
+        // Each cycle of 8 frames starts the eighths' turns at a random one: a slot is looked
+        // at once per cycle, 1 to 15 frames after the last time, so that a steady motion
+        // whose fat-box exits recur every 8 frames is not always looked at in the same phase
+        // of them (always or never leaving).
+        moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
+        turnOffset_ = below(moveSampleState_, kMotionSampleEvery);
+        // The next class (set every 8 frames, at its start): about kExaminedMoves of the
+        // objects (the stride the power of two at or above the quotient: from half of them
+        // to all).
+        const std::size_t stride =
+            std::max<std::size_t>(1, (liveCount_ - parkedCount_) / kExaminedMoves);
+        std::size_t power = 1;
+        while (power < stride) {
+            power *= 2;
+        }
+        sampleMask_ = power - 1;
+    }
+    if (frames == 1) {
+        spreadMask_ = sampleMask_;
+        spreadClass_ = 0;
+        countSwapsThisFrame_ = true;
+        return;
+    }
+    const std::size_t turn = (frames + turnOffset_) % kMotionSampleEvery;
+    spreadMask_ = (sampleMask_ + 1) * kMotionSampleEvery - 1;
+    spreadClass_ = turn * (sampleMask_ + 1);
+    countSwapsThisFrame_ = turn == (frames / kMotionSampleEvery) % kMotionSampleEvery;
+}
+
+void BroadphaseAdapter::countMovingSwaps(double frameMoves) {
     const std::size_t k = frameMoves_.size();
     if (k >= 2) {
         // Two moved ends swap when their order before the frame and after it differ; a tie
@@ -505,21 +539,12 @@ void BroadphaseAdapter::countMovingSwaps() {
                 }
             }
         }
-        const double m = frameMoveCount_;
+        const double m = frameMoves;
         movingSwaps_ += double(flips) / (double(k) * double(k - 1) / 2) * (m * (m - 1) / 2);
     }
-    movingSwapMoves_ += frameMoveCount_;
+    movingSwapMoves_ += frameMoves;
     frameMoves_.clear();
-    frameMoveCount_ = frameExamined_ = 0;
-    // The next sampled frame looks at about kExaminedMoves of the objects (the stride the
-    // power of two at or above the quotient: from half of them to all).
-    const std::size_t stride =
-        std::max<std::size_t>(1, (liveCount_ - parkedCount_) / kExaminedMoves);
-    std::size_t power = 1;
-    while (power < stride) {
-        power *= 2;
-    }
-    sampleMask_ = power - 1;
+    frameExamined_ = 0;
 }
 
 double BroadphaseAdapter::estimateSwapsPerMove(const std::vector<ObjectId>& sampledSlots,
@@ -641,15 +666,21 @@ bool BroadphaseAdapter::beginPairs() {
         coreMoved += (kind & kCoreMoved) != 0 ? 1 : 0;
     }
     moved_.clear();
-    if (sampleMotion_) {
-        countMovingSwaps();  // the sampled frame's moves are all in
+    // The frame's moves: every setAabb that changed a box.
+    const std::size_t moves = counters_.coreUpdates + counters_.movesInsideFatBoxes;
+    const double frameMoves = double(moves - movesAtSearch_);
+    movesAtSearch_ = moves;
+    if (measuring_) {
+        measuredMoves_ += frameMoves;
+        if (countSwapsThisFrame_) {
+            countMovingSwaps(frameMoves);  // the frame's moves are all in
+        }
     }
     checkCacheForLostPairs();
     if (processing_.empty()) {
         ++counters_.idleFrames;
     }
     ++measuredFrames_;
-    measuredMotionFrames_ += sampleMotion_ ? 1 : 0;
     // The core's all-pairs search pays when many objects moved (and on the first frame).
     if (forceFullSearch_) {
         forceFullSearch_ = false;
@@ -953,7 +984,7 @@ void BroadphaseAdapter::endSearch(btDispatcher* dispatcher, bool full, std::size
     counters_.incrementalSearches += full ? 0 : 1;
     counters_.fullSearches += full ? 1 : 0;
     ++counters_.frames;
-    sampleMotion_ = measuring_ && counters_.frames % kMotionSampleEvery == 1;
+    chooseExamined(counters_.frames);
     counters_.candidatesLastFrame = candidates;
     counters_.pairsTestedLastFrame = testedThisFrame_;
     counters_.objectsLookedAtLastFrame = processing_.size();
@@ -997,7 +1028,7 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     out.objects = liveCount_ - parkedCount_;
     const double frames = std::max<double>(1, double(measuredFrames_));
     out.frames = double(measuredFrames_);
-    out.movedPerFrame = measuredMoves_ / std::max<double>(1, double(measuredMotionFrames_));
+    out.movedPerFrame = measuredMoves_ / frames;
     out.relativeMotion = measuredChanges_ > 0 ? measuredMotion_ / measuredChanges_ : 0;
     out.fatExitsPerMove = measuredChanges_ > 0 ? measuredFatExits_ / measuredChanges_ : 0;
     const std::size_t pairChanges = counters_.pairsAdded + counters_.pairsRemoved;
@@ -1012,7 +1043,7 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     out.boxQueriesPerFrame = measuredQueries_ / frames;
     measuredChanges_ = measuredMoves_ = measuredMotion_ = measuredRays_ = measuredQueries_ = 0;
     measuredRayLength_ = 0;
-    measuredFrames_ = measuredMotionFrames_ = 0;
+    measuredFrames_ = 0;
     // Sizes and centres from a sample of at most 1024 live boxes (planes and other
     // boxes over 1e6 m left out).
     std::vector<double> sizes;

@@ -404,16 +404,31 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     }
 
   private:
-    /// Motion is sampled in one frame of every kMotionSampleEvery (the frame after a search
-    /// whose number is 1 modulo it): its per-setAabb cost stays out of the other frames.
+    /// The moves of a class of about kExaminedMoves slots are looked at (noteMotion), each
+    /// slot every kMotionSampleEvery frames: the frame after search 1 looks at the whole
+    /// class (the first decision, at search 2, has a full frame), and from search 8 on every
+    /// frame looks at one eighth of it (spreadMask_ / spreadClass_). A sampled frame that
+    /// looked at the whole class every 8 frames cost 8-20 us per 1000 moves, so that its
+    /// frames stood out of a falling world's cheap ones and moved auto's median frame.
     static constexpr std::size_t kMotionSampleEvery = 8;
     bool measuring_ = false;
-    bool sampleMotion_ = false;  ///< this frame's setAabb calls feed the motion measure
+    /// The coming frame's moves of the slots with (slot & spreadMask_) == spreadClass_ are
+    /// looked at (none: mask 0, class 1).
+    std::size_t spreadMask_ = 0, spreadClass_ = 1;
+    std::size_t turnOffset_ = 0;  ///< the eighth looked at first in this cycle of 8 frames
+    /// The coming frame's examined moves also feed frameMoves_ (one frame in
+    /// kMotionSampleEvery, the eighths of the class taking turns), counted at its search.
+    bool countSwapsThisFrame_ = false;
+    /// Sets the above for the frame after `frames` completed searches.
+    void chooseExamined(std::size_t frames);
     bool forceFullSearch_ = false;
-    /// measuredMoves_: every move in the sampled frames; measuredChanges_: those looked at.
+    /// measuredMoves_: every move (counted at the searches); measuredChanges_: those looked
+    /// at.
     double measuredChanges_ = 0, measuredMoves_ = 0, measuredMotion_ = 0, measuredRays_ = 0,
            measuredQueries_ = 0, measuredRayLength_ = 0, measuredFatExits_ = 0;
-    std::size_t measuredFrames_ = 0, measuredMotionFrames_ = 0;
+    std::size_t measuredFrames_ = 0;
+    /// coreUpdates + movesInsideFatBoxes at the last search: the frame's moves.
+    std::size_t movesAtSearch_ = 0;
     std::size_t pairChangesSeen_ = 0;  ///< pairsAdded + pairsRemoved at the last measure
     /// At most this many sampled moves per measure are kept for the swap estimate, and at
     /// most kSwapSampleBoxes boxes' endpoints counted against them; below kSwapEstimateFrom
@@ -436,17 +451,16 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// `sample` (at most `capacity`) with probability capacity / seen.
     void keepSample(std::vector<SampledMove>& sample, std::size_t capacity, std::size_t seen,
                     const SampledMove& move);
-    /// At the end of a sampled frame: the order changes among frameMoves_ (a uniform sample
-    /// of that frame's moves) scaled to all of the frame's moves, into movingSwaps_.
-    void countMovingSwaps();
+    /// At the search after a frame that fed frameMoves_: the order changes among them (a
+    /// uniform sample of that frame's `frameMoves` moves) scaled to all of them, into
+    /// movingSwaps_.
+    void countMovingSwaps(double frameMoves);
     static constexpr std::size_t kFrameSampleMoves = 32;
     std::vector<SampledMove> frameMoves_;
-    double frameMoveCount_ = 0;  ///< moves in the sampled frame under way
-    double frameExamined_ = 0;   ///< of those, the moves looked at (slot & sampleMask_ == 0)
-    /// A sampled frame looks at the moves of the slots divisible by sampleMask_ + 1, a power
-    /// of two (about kExaminedMoves of the live objects, at least half as many; set at the
-    /// end of each sampled frame): a mask, where a division cost more than the rest of
-    /// noteMotion for the moves not looked at.
+    double frameExamined_ = 0;  ///< the moves looked at in that frame
+    /// The class looked at: the slots divisible by sampleMask_ + 1, a power of two (about
+    /// kExaminedMoves of the live objects, at least half as many; set every 8 frames): a
+    /// mask, where a division cost more than the rest of a move.
     std::size_t sampleMask_ = 0;
     static constexpr std::size_t kExaminedMoves = 256;
     double movingSwaps_ = 0;      ///< estimated swaps among moved objects, sampled frames
