@@ -1006,7 +1006,7 @@ TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
 
 // A world that rests for its first frames (offset-1e6's bodies: until their speed reaches a
 // float step) tells auto nothing about its motion: it keeps the starting grid, says so, and
-// looks again after every sampled frame, so that its first decision comes from the first
+// looks again every 8 frames, so that its first decision comes from the first
 // motion, at once (not two evaluations of 32 frames later). The motion that follows either
 // passes many tied endpoints (the grid) or none (the sweep). Before this rule the still
 // frames took the sweep, and the tied motion reached the grid only at frame 96.
@@ -1040,7 +1040,7 @@ TEST(Auto, AWorldThatStartsStillIsJudgedByItsFirstMotion) {
             }
         }
         adapter.validate();
-        // Within one sampled frame (8) of the first motion, one switch, the right core.
+        // Within 8 frames of the first motion, one switch, the right core.
         const std::string description = adapter.coreDescription();
         EXPECT_EQ(description.rfind(tied ? "auto: grid" : "auto: sweep", 0), 0u) << description;
         EXPECT_NE(description.find(tied ? "would swap much" : "move few places"), std::string::npos)

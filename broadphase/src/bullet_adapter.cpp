@@ -426,9 +426,9 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     // the search.
     const Box& from = boxes_[slot];
     // Would a fat box have held this move? With fat boxes, it is the core box; while the
-    // core tracks overlaps, fat_ is a shadow kept up to date only here (in sampled frames,
-    // so a slow drift counts more leavings than the fat boxes would have: the measure
-    // errs towards the sweep).
+    // core tracks overlaps, fat_ is a shadow kept up to date only here (when the slot is
+    // looked at, once in 8 frames, so a slow drift counts more leavings than the fat boxes
+    // would have: the measure errs towards the sweep).
     if (!contains(fat_[slot], to)) {
         measuredFatExits_ += 1;
         if (coreTracksOverlaps_) {
@@ -514,7 +514,7 @@ void BroadphaseAdapter::countMovingSwaps(double frameMoves) {
         // counts as ordered by sample index (as the sweep orders ties by id: about half of
         // the ties a move makes or breaks are swaps).
         // Branch-free: the outcomes are coin tosses (a branch per comparison cost 20 us per
-        // sampled frame).
+        // frame counted).
         auto beforeOf = [](btScalar a, btScalar b, bool firstBefore) {
             return (a < b) | ((a == b) & firstBefore);
         };
@@ -554,8 +554,8 @@ double BroadphaseAdapter::estimateSwapsPerMove(const std::vector<ObjectId>& samp
         liveCount_ - parkedCount_ < kSwapEstimateFrom) {
         return 0;
     }
-    // The moved objects passing each other (counted within each sampled frame, where both
-    // ends of a swap are known before and after)...
+    // The moved objects passing each other (counted within each frame that fed
+    // frameMoves_, where both ends of a swap are known before and after)...
     const double moving = movingSwapMoves_ > 0 ? movingSwaps_ / movingSwapMoves_ : 0;
     // ... and passing the others, which stay where they are: the sampled moves against the
     // sampled boxes' ends, for the share of the objects that did not move. (Against every

@@ -24,8 +24,8 @@
 ///   3.09 and 3.48);
 /// - at rest (under half an object moved per frame): the present core, which costs nothing
 ///   while no box changes. Before the first decision that is no decision: a world that has
-///   not moved yet keeps the starting core, and auto looks again after every sampled frame
-///   (every 8) until something moves (offset-1e6's bodies rest for their first frames, until
+///   not moved yet keeps the starting core, and auto looks again every 8 frames until
+///   something moves (offset-1e6's bodies rest for their first frames, until
 ///   their speed reaches a float step; judged from those frames, it took the sweep, which
 ///   then took 2-3x the grid's time for 96 frames);
 /// - resting jitter (objects move every frame but their fat boxes hold every move and no
@@ -139,7 +139,7 @@ class AutoCore {
 
     Kind kind() const { return kind_; }
     /// True until an evaluation has seen motion (or sizes or rays that decide alone): the
-    /// adapter evaluates after every sampled frame meanwhile, not every evaluateEvery.
+    /// adapter evaluates every 8 frames meanwhile, not every evaluateEvery.
     bool undecided() const { return evaluations_ == 0; }
     bool tracksOverlaps() const { return kind_ == Kind::Sweep; }
     /// Why the present core was chosen (for kolize-demo), and how many switches so far.
@@ -153,7 +153,7 @@ class AutoCore {
         // While the sweep runs, its swaps are counted, not estimated: the estimate (sampled
         // moves against the boxes at this evaluation) misses where a world moved away from
         // the sampled moves (mixed-terrain's falling bodies: estimated 18 per move at frame
-        // 32, counted 49 in the sampled frames).
+        // 32, counted 49 in the frames sampled then).
         swapsCounted_ = kind_ == Kind::Sweep && updates_ > updatesSeen_;
         if (swapsCounted_) {
             measure.swapsPerMove =
@@ -309,8 +309,8 @@ class AutoCore {
         if (m.movedPerFrame < 0.5) {
             // Before the first decision, a world that has not moved tells nothing about its
             // motion (offset-1e6's bodies start moving when their speed first reaches a float
-            // step, after a few frames): the starting core stays and auto looks again after
-            // the next sampled frame.
+            // step, after a few frames): the starting core stays and auto looks again 8
+            // frames later.
             waiting_ = evaluations_ == 0;
             ruleReason_ = waiting_ ? "no motion yet: the start's core until something moves"
                                    : "at rest (" + shortNumber(m.movedPerFrame) +

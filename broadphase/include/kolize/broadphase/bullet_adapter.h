@@ -394,10 +394,10 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     void prepareCoreSwitch(bool tracking, btDispatcher* dispatcher);
     /// After the core was emptied: inserts every live object again, sets the mode.
     void finishCoreSwitch(bool tracking);
-    /// Whether the pair search after `frame` completed searches is the one after the search
-    /// that counted a sampled frame (as the first evaluation, after two searches, is): the
-    /// measure then holds a new frame of motion.
-    static bool followsSampledFrame(std::size_t frame) { return frame % kMotionSampleEvery == 2; }
+    /// Whether an undecided auto looks again at the pair search after `frame` completed
+    /// searches: every 8 frames, at 2 modulo 8 as the first evaluation (the measure then
+    /// holds a new cycle of looked-at moves).
+    static bool looksAgainUndecided(std::size_t frame) { return frame % kMotionSampleEvery == 2; }
     /// Whether a move, ray or box query was measured since the last measure.
     bool measuredAny() const {
         return measuredMoves_ > 0 || measuredRays_ > 0 || measuredQueries_ > 0;
@@ -598,13 +598,13 @@ class CoreBroadphase final : public BroadphaseAdapter {
         if constexpr (kAuto) {
             const std::size_t frame = stats().frames;
             const std::size_t every = std::size_t(std::max(1, coreSettings_.evaluateEvery));
-            // Undecided, it looks again after each sampled frame that saw a move, a ray or a
-            // query (a world at rest from the start pays only the regular evaluations). Frame
-            // 18 closes the first full window (frames 2-17, two sampled frames): the guess
+            // Undecided, it looks again every 8 frames once a move, a ray or a query was seen
+            // (a world at rest from the start pays only the regular evaluations). Frame 18
+            // closes the first full window (frames 2-17): the guess
             // from two frames is corrected there, not at frame 32 (a pyramid that jitters
             // spent frames 2-31 on the sweep at 2.5x the grid's time).
             const bool due = frame == 2 || frame == kFirstWindowEnd || frame % every == 0 ||
-                             (core_.undecided() && followsSampledFrame(frame) && measuredAny());
+                             (core_.undecided() && looksAgainUndecided(frame) && measuredAny());
             if (frame == 0 || !due) {
                 return;
             }
