@@ -1287,6 +1287,72 @@ TEST(Auto, CountsEveryMoveUnderTheGridAndUnderTheSweep) {
     EXPECT_EQ(movedInDescription(evaluated[1]), 240) << evaluated[1];
 }
 
+/// A ray callback prepared the way btCollisionWorld prepares its own; counts its hits.
+struct CountingRayCallback : btBroadphaseRayCallback {
+    CountingRayCallback(const btVector3& from, const btVector3& to) {
+        btVector3 direction = to - from;
+        direction.normalize();
+        for (int axis = 0; axis < 3; ++axis) {
+            m_rayDirectionInverse[axis] = direction[axis] == btScalar(0)
+                                              ? btScalar(BT_LARGE_FLOAT)
+                                              : btScalar(1) / direction[axis];
+            m_signs[axis] = m_rayDirectionInverse[axis] < 0;
+        }
+        m_lambda_max = direction.dot(to - from);
+    }
+    bool process(const btBroadphaseProxy*) override {
+        ++hits;
+        return true;
+    }
+    std::size_t hits = 0;
+};
+
+// Many long rays take the spatial hash, whose walk visits few cells; short ones (CCD's sweeps
+// of one step's motion) do not decide. The rule needs the boxes' median size, which auto
+// samples only when a rule asks for it (SceneMeasure::sampleBoxes): without that sample the
+// rays' length in box sizes would read 0 and the long rays would not count. 400 unit boxes
+// drifting slowly; 64 rays per frame along x through a row, 60 or 2 box sizes long.
+TEST(Auto, ManyLongRaysTakeTheSpatialHashAndShortOnesDoNot) {
+    for (const btScalar reach : {btScalar(60), btScalar(2)}) {
+        SCOPED_TRACE("rays " + std::to_string(double(reach)) + " box sizes long");
+        auto broadphase = makeBroadphase("auto");
+        auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
+        const std::vector<btScalar> base = tiedOrSpread(false);
+        BoxMap boxes;
+        const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
+        std::size_t hits = 0;
+        for (int frame = 0; frame < 40; ++frame) {
+            for (std::size_t i = 0; i < proxies.size(); ++i) {
+                ProxyBox& box = boxes[proxies[i]];
+                const btScalar x = base[i] + btScalar(0.01) * btScalar(frame);
+                box.aabbMin.setX(x);
+                box.aabbMax.setX(x + 1);
+                broadphase->setAabb(proxies[i], box.aabbMin, box.aabbMax, nullptr);
+            }
+            const FramePairs pairs = searchPairs(*broadphase, boxes, nullptr);
+            ASSERT_EQ(pairs.cached, pairs.truth) << "frame " << frame;
+            for (int ray = 0; ray < 64; ++ray) {
+                // Through the middle of row (ray % 20, 0): y and z at the boxes' centres.
+                const btVector3 from(btScalar(3 * ray), btScalar(1.5 * (ray % 20) + 0.5),
+                                     btScalar(0.5));
+                const btVector3 to = from + btVector3(reach, 0, 0);
+                CountingRayCallback callback(from, to);
+                broadphase->rayTest(from, to, callback);
+                hits += callback.hits;
+            }
+        }
+        adapter.validate();
+        EXPECT_GT(hits, 0u);  // the rays meet boxes
+        const std::string description = adapter.coreDescription();
+        if (reach > 8) {
+            EXPECT_EQ(description.rfind("auto: spatial-hash (64 rays per frame", 0), 0u)
+                << description;
+        } else {
+            EXPECT_EQ(description.rfind("auto: sweep (slow motion", 0), 0u) << description;
+        }
+    }
+}
+
 // Found by the fuzzer (seed 1, shrunk): "auto" switched to sweep after two searches of an
 // empty world; resetPool then restarted its core on the grid while the adapter still took it
 // for a core that tracks overlaps, and the next pair of overlapping proxies was never found.

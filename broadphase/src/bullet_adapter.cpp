@@ -1044,6 +1044,15 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     measuredChanges_ = measuredMoves_ = measuredMotion_ = measuredRays_ = measuredQueries_ = 0;
     measuredRayLength_ = 0;
     measuredFrames_ = 0;
+    // The box sample only when a rule asks (before the next move: the boxes and the move
+    // samples are those of this evaluation).
+    out.sampleBoxes = [this, meanRayLength](SceneMeasure& measure) {
+        sampleBoxes(measure, meanRayLength);
+    };
+    return out;
+}
+
+void BroadphaseAdapter::sampleBoxes(SceneMeasure& out, double meanRayLength) const {
     // Sizes and centres from a sample of at most 1024 live boxes (planes and other
     // boxes over 1e6 m left out).
     std::vector<double> sizes;
@@ -1068,10 +1077,8 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
         }
     }
     out.swapsPerMove = estimateSwapsPerMove(sampledSlots, out.movedPerFrame);
-    sampledMoves_.clear();
-    movingSwaps_ = movingSwapMoves_ = 0;
     if (sizes.size() < 8) {
-        return out;
+        return;
     }
     // The median size (a selection, not a sort).
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
@@ -1079,7 +1086,11 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     out.rayLength = median > 0 ? meanRayLength / median : (meanRayLength > 0 ? 1e9 : 0);
     out.medianSize = median;
     out.centres = std::move(centres);
-    return out;
+}
+
+void BroadphaseAdapter::forgetMoveSamples() {
+    sampledMoves_.clear();
+    movingSwaps_ = movingSwapMoves_ = 0;
 }
 
 void BroadphaseAdapter::prepareCoreSwitch(bool tracking, btDispatcher* dispatcher) {

@@ -386,8 +386,15 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// While the core tracks overlaps: starts the shadow fat box of `slot`, just inserted
     /// into the core with its exact box.
     void startShadow(ObjectId slot);
-    /// What was measured since the last call; resets the accumulators. O(sampled objects).
+    /// What was measured since the last call; resets the accumulators, but for the move
+    /// samples (forgetMoveSamples, after the decision). O(1): the box sample is left to
+    /// SceneMeasure::sampleBoxes.
     SceneMeasure takeMeasure();
+    /// Fills `out`'s median size, centres, ray length (from the mean ray reach) and swap
+    /// estimate from a sample of at most 1024 boxes.
+    void sampleBoxes(SceneMeasure& out, double meanRayLength) const;
+    /// Drops the move samples of the swap estimate (after each evaluation).
+    void forgetMoveSamples();
     /// Before the core is replaced: every pair tested (statuses current, the cache
     /// updated), core boxes made exact; with `tracking` (the new core tracks overlaps) the
     /// apart pairs are erased, without it every pair awaits a test at a full search.
@@ -609,6 +616,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
                 return;
             }
             const typename Core::Kind wanted = core_.decide(takeMeasure());
+            forgetMoveSamples();
             if (wanted == core_.kind()) {
                 return;
             }
