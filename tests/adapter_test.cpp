@@ -8,6 +8,8 @@
 #include <kolize/engine/pair_stream.h>
 #include <kolize/kolize.h>
 
+#include "ray_callback.h"
+
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
 
@@ -1287,19 +1289,9 @@ TEST(Auto, CountsEveryMoveUnderTheGridAndUnderTheSweep) {
     EXPECT_EQ(movedInDescription(evaluated[1]), 240) << evaluated[1];
 }
 
-/// A ray callback prepared the way btCollisionWorld prepares its own; counts its hits.
-struct CountingRayCallback : btBroadphaseRayCallback {
-    CountingRayCallback(const btVector3& from, const btVector3& to) {
-        btVector3 direction = to - from;
-        direction.normalize();
-        for (int axis = 0; axis < 3; ++axis) {
-            m_rayDirectionInverse[axis] = direction[axis] == btScalar(0)
-                                              ? btScalar(BT_LARGE_FLOAT)
-                                              : btScalar(1) / direction[axis];
-            m_signs[axis] = m_rayDirectionInverse[axis] < 0;
-        }
-        m_lambda_max = direction.dot(to - from);
-    }
+/// Counts a ray's hits.
+struct CountingRayCallback : PreparedRayCallback {
+    using PreparedRayCallback::PreparedRayCallback;
     bool process(const btBroadphaseProxy*) override {
         ++hits;
         return true;

@@ -7,6 +7,8 @@
 #include <kolize/engine/pair_compare.h>
 #include <kolize/kolize.h>
 
+#include "ray_callback.h"
+
 #include <LinearMath/btAabbUtil2.h>
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
@@ -60,19 +62,9 @@ class UidSumFilter : public btOverlapFilterCallback {
     }
 };
 
-/// Ray callback prepared the way btCollisionWorld prepares its own.
-struct CollectingRayCallback : btBroadphaseRayCallback {
-    CollectingRayCallback(const btVector3& from, const btVector3& to) {
-        btVector3 direction = to - from;
-        direction.normalize();
-        for (int axis = 0; axis < 3; ++axis) {
-            m_rayDirectionInverse[axis] = direction[axis] == btScalar(0)
-                                              ? btScalar(BT_LARGE_FLOAT)
-                                              : btScalar(1) / direction[axis];
-            m_signs[axis] = m_rayDirectionInverse[axis] < 0;
-        }
-        m_lambda_max = direction.dot(to - from);
-    }
+/// Collects a ray's hits.
+struct CollectingRayCallback : PreparedRayCallback {
+    using PreparedRayCallback::PreparedRayCallback;
     bool process(const btBroadphaseProxy* proxy) override {
         clients.insert(proxy->m_clientObject);
         return true;

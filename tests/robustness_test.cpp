@@ -7,6 +7,8 @@
 #include <kolize/broadphase/cell_grid.h>
 #include <kolize/kolize.h>
 
+#include "ray_callback.h"
+
 #include <LinearMath/btAabbUtil2.h>
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
@@ -91,18 +93,9 @@ struct AabbCallback : btBroadphaseAabbCallback {
     }
 };
 
-/// A ray callback prepared the way btCollisionWorld::rayTest prepares its own.
-struct RayCallback : btBroadphaseRayCallback {
-    RayCallback(const btVector3& from, const btVector3& to) {
-        btVector3 direction = (to - from).normalized();
-        for (int axis = 0; axis < 3; ++axis) {
-            m_rayDirectionInverse[axis] = direction[axis] == btScalar(0)
-                                              ? btScalar(BT_LARGE_FLOAT)
-                                              : btScalar(1) / direction[axis];
-            m_signs[axis] = m_rayDirectionInverse[axis] < 0;
-        }
-        m_lambda_max = direction.dot(to - from);
-    }
+/// Collects a ray's hits and calls onHit for each.
+struct RayCallback : PreparedRayCallback {
+    using PreparedRayCallback::PreparedRayCallback;
     std::function<void(const btBroadphaseProxy*)> onHit;
     std::vector<const void*> hits;
     bool process(const btBroadphaseProxy* proxy) override {
