@@ -898,14 +898,19 @@ TEST(Auto, RestingJitterTakesTheGridUnlessPairsChangeAndRestKeepsTheCore) {
     }
 }
 
-/// The number in "<number> endpoints passed per moved object" of a core description.
-double passedInDescription(const std::string& description) {
-    const std::size_t at = description.find(" endpoints passed per moved object");
+/// The number in "(<number><what>" of a core description, or -1.
+double numberInDescription(const std::string& description, const std::string& what) {
+    const std::size_t at = description.find(what);
     if (at == std::string::npos) {
         return -1;
     }
     const std::size_t start = description.rfind('(', at);
     return std::stod(description.substr(start + 1, at - start - 1));
+}
+
+/// The number in "<number> endpoints passed per moved object" of a core description.
+double passedInDescription(const std::string& description) {
+    return numberInDescription(description, " endpoints passed per moved object");
 }
 
 /// The x-lows of 400 unit boxes: all 0 (tied) or 3 apart (spread: no two x-intervals meet).
@@ -1236,13 +1241,8 @@ TEST(Auto, AFewObjectsTakeTheSweep) {
 }
 
 /// The number in "(<number> objects moved per frame" of a core description.
-int movedInDescription(const std::string& description) {
-    const std::size_t at = description.find(" objects moved per frame");
-    if (at == std::string::npos) {
-        return -1;
-    }
-    const std::size_t start = description.rfind('(', at);
-    return std::stoi(description.substr(start + 1, at - start - 1));
+double movedInDescription(const std::string& description) {
+    return numberInDescription(description, " objects moved per frame");
 }
 
 // auto counts every move (every setAabb that changed a box: under the grid mostly moves
