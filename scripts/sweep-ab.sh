@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The sweep core of two commits on the same recorded pair streams (core work only: update,
+# maintain, drainChanges), alternating, median of R rounds:
+#   scripts/sweep-ab.sh REV_A REV_B [ROUNDS] STREAM...
+# Record a stream with: build/demos/kolize-demo --scene S --broadphase sweep --frames 300
+#   --record FILE. Needs the float build (scripts/build.sh) for the stream reader.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ $# -lt 3 ]; then
+    echo "usage: scripts/sweep-ab.sh REV_A REV_B [ROUNDS] STREAM..." >&2
+    exit 2
+fi
+a=$1
+b=$2
+shift 2
+rounds=9
+if [[ $1 =~ ^[0-9]+$ ]]; then
+    rounds=$1
+    shift
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+header=broadphase/include/kolize/broadphase/sweep_and_prune.h
+rename() {  # distinct names for the two versions in one program
+    sed -e "s/SweepAndPrune/Sweep$1/g; s/sweep_detail/sweep_detail_$1/g; s/SweepSettings/SweepSettings$1/g"
+}
+git show "$a:$header" | rename A > "$work/A.h"
+git show "$b:$header" | rename B > "$work/B.h"
+build=${BUILD_DIR:-build}
+g++ -O2 -std=c++17 -DNDEBUG -I"$work" -Ibroadphase/include -Iengine/include -I/usr/include/bullet \
+    scripts/sweep-ab/sweep_ab.cpp -o "$work/sweep_ab" "$build/engine/libkolize_engine.a" \
+    "$build/broadphase/libkolize_broadphase.a" -lBulletDynamics -lBulletCollision -lLinearMath
+echo "A = $a, B = $b, $rounds rounds"
+"$work/sweep_ab" "$rounds" "$@"
