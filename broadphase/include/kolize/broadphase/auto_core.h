@@ -75,11 +75,11 @@
 #include <kolize/broadphase/sweep_and_prune.h>
 
 #include <algorithm>
-#include <functional>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 

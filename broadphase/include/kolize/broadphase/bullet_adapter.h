@@ -415,7 +415,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// slot every kMotionSampleEvery frames: the frame after search 1 looks at the whole
     /// class (the first decision, at search 2, has a full frame), and from search 8 on every
     /// frame looks at one eighth of it (spreadMask_ / spreadClass_). A sampled frame that
-    /// looked at the whole class every 8 frames cost 8-20 us per 1000 moves, so that its
+    /// looked at the whole class every 8 frames cost 8-21 us per 1000 moves, so that its
     /// frames stood out of a falling world's cheap ones and moved auto's median frame.
     static constexpr std::size_t kMotionSampleEvery = 8;
     bool measuring_ = false;
