@@ -463,11 +463,15 @@ void BroadphaseAdapter::keepSample(std::vector<SampledMove>& sample, std::size_t
         sample.push_back(move);
         return;
     }
-    moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
-    const std::size_t at = below(moveSampleState_, seen);
+    const std::size_t at = draw(seen);
     if (at < capacity) {
         sample[at] = move;
     }
+}
+
+std::size_t BroadphaseAdapter::draw(std::size_t bound) {
+    moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
+    return below(moveSampleState_, bound);
 }
 
 void BroadphaseAdapter::chooseExamined(std::size_t frames) {
@@ -482,8 +486,7 @@ void BroadphaseAdapter::chooseExamined(std::size_t frames) {
         // at once per cycle, 1 to 15 frames after the last time, so that a steady motion
         // whose fat-box exits recur every 8 frames is not always looked at in the same phase
         // of them (always or never leaving).
-        moveSampleState_ = moveSampleState_ * 6364136223846793005u + 1442695040888963407u;
-        turnOffset_ = below(moveSampleState_, kMotionSampleEvery);
+        turnOffset_ = draw(kMotionSampleEvery);
         // The next class (set every 8 frames, at its start): about kExaminedMoves of the
         // objects (the stride the power of two at or above the quotient: from half of them
         // to all).

@@ -319,10 +319,11 @@ class AutoCore {
                           " objects: a sweep over so few costs least, whatever they do";
             return Kind::Sweep;
         }
-        if (m.raysPerFrame >= std::max(16.0, n / 64)) {
-            needSamples(m);
+        const bool manyRays = m.raysPerFrame >= std::max(16.0, n / 64);
+        if (manyRays) {
+            needSamples(m);  // the rays' length in median box sizes
         }
-        if (m.raysPerFrame >= std::max(16.0, n / 64) && m.rayLength >= kLongRay) {
+        if (manyRays && m.rayLength >= kLongRay) {
             ruleReason_ = std::to_string(int(m.raysPerFrame)) + " rays per frame, " +
                           shortNumber(m.rayLength) +
                           " box sizes long: the sparse cells walk rays through few cells";

@@ -448,6 +448,8 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     };
     std::vector<SampledMove> sampledMoves_;  ///< a uniform sample of the sampled moves
     std::uint64_t moveSampleState_ = 0x9e3779b97f4a7c15u;  ///< the sample's fixed-seed generator
+    /// The generator's next number below `bound`.
+    std::size_t draw(std::size_t bound);
     /// Endpoints a sorted sweep would pass per move: the moved objects passing each other,
     /// from the order changes within a sample of one frame's moves (movingSwaps_), plus the
     /// sampled moves against the sampled boxes' endpoints for the share of objects that did
