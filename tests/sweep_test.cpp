@@ -271,6 +271,170 @@ TEST(SweepTracking, ABatchTranslatedTogetherSwapsNothing) {
     EXPECT_EQ(pairs, 7u * 8 * 2 + 7 * 7 * 2) << "no change recorded";
 }
 
+// A stack on its side: layers along x whose ends are tied but for a jitter that reorders the
+// mins (and the maxes) of a layer among themselves every frame without passing an end of the
+// other kind, so the pass over x is left out and x's runs stay unsorted (the same jitter on
+// y and z, whose gaps are wider). Between those frames, what needs sorted arrays or reads
+// the order: a frame of few moves (one object at a time, moveOne), objects created (merge)
+// and removed (compact), a big move that does pass ends of the other kind, and box queries
+// along x (whose scan must not stop inside an unsorted run). Pairs against a brute force
+// after every frame, queries against the first-axis truth.
+template <class Scalar>
+void runUnsortedRuns(std::uint32_t seed) {
+    using SBox = kolize::Aabb<3, Scalar>;
+    std::printf("unsorted runs, seed %u\n", seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0, 1);
+    kolize::SweepAndPrune<3, Scalar> core;
+    constexpr kolize::ObjectId kSlots = 200;
+    std::vector<SBox> boxes(kSlots);
+    std::vector<bool> live(kSlots, false);
+    // Layer k spans x in [k - 0.02, k + 1.02]: it overlaps its neighbours by 0.04, and its
+    // ends are tied to theirs but for the jitter. In y and z a 4 x 4 grid, 0.1 apart.
+    auto place = [&](kolize::ObjectId id) {
+        const int layer = int(id % 8), cell = int((id / 8) % 16);
+        SBox box;
+        box.lo[0] = Scalar(layer - 0.02);
+        box.hi[0] = Scalar(layer + 1.02);
+        box.lo[1] = Scalar(1.1 * (cell % 4));
+        box.hi[1] = box.lo[1] + 1;
+        box.lo[2] = Scalar(1.1 * (cell / 4));
+        box.hi[2] = box.lo[2] + 1;
+        return box;
+    };
+    auto overlapping = [](const SBox& a, const SBox& b) {
+        for (int axis = 0; axis < 3; ++axis) {
+            if (a.hi[axis] < b.lo[axis] || b.hi[axis] < a.lo[axis]) {
+                return false;
+            }
+        }
+        return true;
+    };
+    for (kolize::ObjectId id = 0; id < 128; ++id) {
+        boxes[id] = place(id);
+        live[id] = true;
+        core.insert(id, boxes[id]);
+    }
+    std::set<Pair> tracked;
+    std::vector<kolize::ObjectId> away;
+    std::size_t queries = 0, queryHits = 0, bigMoves = 0, created = 0, removed = 0;
+    for (int frame = 0; frame < 240; ++frame) {
+        const int kind = frame % 12;
+        if (kind == 5) {  // a few objects move far, one at a time, and come back next frame
+            for (int k = 0; k < 3; ++k) {
+                const kolize::ObjectId id = kolize::ObjectId(rng() % kSlots);
+                if (!live[id]) {
+                    continue;
+                }
+                // By a multiple of 1.04: an end lands among the tied ends of the other kind
+                // (a min at a layer's maxes), to be placed against each of them.
+                const Scalar shift = Scalar(1.04 * (int(rng() % 4) - 2 + (k % 2 == 0 ? 0 : 1)));
+                boxes[id].lo[0] += shift;
+                boxes[id].hi[0] += shift;
+                core.update(id, boxes[id]);
+                away.push_back(id);
+                ++bigMoves;
+            }
+        } else if (kind == 6) {
+            for (kolize::ObjectId id : away) {
+                if (live[id]) {
+                    boxes[id] = place(id);
+                    core.update(id, boxes[id]);
+                }
+            }
+            away.clear();
+        } else if (kind == 9) {  // objects created and removed
+            for (int k = 0; k < 4; ++k) {
+                const kolize::ObjectId id = kolize::ObjectId(rng() % kSlots);
+                if (live[id]) {
+                    core.remove(id);
+                    live[id] = false;
+                    for (auto it = tracked.begin(); it != tracked.end();) {
+                        it =
+                            it->first == id || it->second == id ? tracked.erase(it) : std::next(it);
+                    }
+                    ++removed;
+                } else {
+                    // Half of them with their min among a layer's tied maxes.
+                    boxes[id] = place(id);
+                    if (k % 2 == 0) {
+                        boxes[id].lo[0] += Scalar(1.04);
+                        boxes[id].hi[0] += Scalar(1.04);
+                    }
+                    live[id] = true;
+                    core.insert(id, boxes[id]);
+                    ++created;
+                }
+            }
+        } else {  // every live object jitters by up to 1e-5 on each end
+            for (kolize::ObjectId id = 0; id < kSlots; ++id) {
+                if (!live[id]) {
+                    continue;
+                }
+                for (int axis = 0; axis < 3; ++axis) {
+                    boxes[id].lo[axis] += Scalar(2e-5 * unit(rng) - 1e-5);
+                    boxes[id].hi[axis] += Scalar(2e-5 * unit(rng) - 1e-5);
+                }
+                core.update(id, boxes[id]);
+            }
+        }
+        core.maintain();
+        core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
+            if (overlapping(boxes[a], boxes[b])) {
+                tracked.insert(ordered(a, b));
+            } else {
+                tracked.erase(ordered(a, b));
+            }
+        });
+        std::set<Pair> truth;
+        for (kolize::ObjectId a = 0; a < kSlots; ++a) {
+            for (kolize::ObjectId b = a + 1; b < kSlots; ++b) {
+                if (live[a] && live[b] && overlapping(boxes[a], boxes[b])) {
+                    truth.insert({a, b});
+                }
+            }
+        }
+        ASSERT_EQ(tracked, truth) << "seed " << seed << ", frame " << frame;
+        core.validate();
+        for (int q = 0; q < 4; ++q) {
+            // A query box whose end falls among a layer's tied mins, or its maxes, or
+            // elsewhere.
+            SBox query;
+            const double at = std::floor(9 * unit(rng)) + (q == 0   ? -0.02
+                                                           : q == 1 ? 1.02
+                                                                    : unit(rng));
+            query.lo[0] = Scalar(at - 0.5 * unit(rng));
+            query.hi[0] = Scalar(at);
+            query.lo[1] = query.lo[2] = -10;
+            query.hi[1] = query.hi[2] = 10;
+            std::set<kolize::ObjectId> seen, expected;
+            core.queryBox(query, [&](kolize::ObjectId id) { seen.insert(id); });
+            for (kolize::ObjectId id = 0; id < kSlots; ++id) {
+                if (live[id] && !(boxes[id].hi[0] < query.lo[0]) &&
+                    !(query.hi[0] < boxes[id].lo[0])) {
+                    expected.insert(id);
+                }
+            }
+            ASSERT_EQ(seen, expected) << "seed " << seed << ", frame " << frame << ", query on x ["
+                                      << query.lo[0] << ", " << query.hi[0] << "]";
+            ++queries;
+            queryHits += expected.size();
+        }
+    }
+    // Meaningful: passes were left out, the other paths all ran, the queries found objects.
+    EXPECT_GT(core.passesLeftOut(), 300u);
+    EXPECT_GT(core.oneByOneSearches(), 10u);
+    EXPECT_GT(bigMoves, 20u);
+    EXPECT_GT(created, 10u);
+    EXPECT_GT(removed, 10u);
+    EXPECT_GT(queryHits, 10 * queries);
+}
+
+TEST(SweepTracking, UnsortedRunsOfTiedEndsKeepPairsQueriesMergesAndSingleMovesExact) {
+    runUnsortedRuns<float>(41);
+    runUnsortedRuns<double>(42);
+}
+
 template <int D, class Scalar>
 void runSweepKit(std::uint64_t seed) {
     // Pairs searched every 7 operations (most moves applied in one pass per axis) and after

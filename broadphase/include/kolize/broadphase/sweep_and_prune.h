@@ -223,10 +223,19 @@ class SweepAndPrune {
                 visit(id);
             }
         }
+        // Past a max above the box's end, every later min is above it too (the axis orders
+        // each min against each max; a run of mins may be unsorted, see kindOrderHolds).
         const std::vector<Endpoint>& edges = axes_[0];
-        for (std::size_t at = 0; at < edges.size() && !(edges[at].value() > box.hi[0]); ++at) {
-            const ObjectId id = edges[at].id();
-            if (!edges[at].isMax() && state_[id] == State::Sorted && !dirty_[id] &&
+        for (std::size_t at = 0; at < edges.size(); ++at) {
+            const Endpoint& edge = edges[at];
+            if (edge.isMax()) {
+                if (edge.value() > box.hi[0]) {
+                    break;
+                }
+                continue;
+            }
+            const ObjectId id = edge.id();
+            if (!(edge.value() > box.hi[0]) && state_[id] == State::Sorted && !dirty_[id] &&
                 !(edges[at_[id][1]].value() < box.lo[0])) {
                 visit(id);
             }
@@ -250,6 +259,8 @@ class SweepAndPrune {
     /// Pair searches whose moves were applied in one insertion pass per axis, and those
     /// applied one object at a time.
     std::size_t batchedSearches() const { return batchedSearches_; }
+    /// Axis passes left out because no min passed a max (see applyMoves).
+    std::size_t passesLeftOut() const { return passesLeftOut_; }
     std::size_t oneByOneSearches() const { return oneByOneSearches_; }
 
     /// Checks the arrays' order, the endpoint positions and values against the boxes, and
@@ -289,10 +300,13 @@ class SweepAndPrune {
         }
         for (int axis = 0; axis < D; ++axis) {
             const std::vector<Endpoint>& edges = axes_[axis];
-            for (std::size_t at = 1; at < edges.size(); ++at) {
-                if (before(edges[at], edges[at - 1])) {
-                    fail("axis " + std::to_string(axis) + " not sorted at " + std::to_string(at));
-                }
+            bool inOrder = true;
+            if (!kindOrderHolds(axis, inOrder)) {
+                fail("axis " + std::to_string(axis) +
+                     " orders a min and a max against their values");
+            }
+            if (sorted_[axis] && !inOrder) {
+                fail("axis " + std::to_string(axis) + " marked sorted but is not");
             }
             std::size_t deadEdges = 0;
             for (const Endpoint& edge : edges) {
@@ -338,6 +352,12 @@ class SweepAndPrune {
 
   private:
     using Endpoint = sweep_detail::Endpoint<Scalar>;
+    template <bool kValue>
+    static std::array<bool, D> make_filled() {
+        std::array<bool, D> out;
+        out.fill(kValue);
+        return out;
+    }
     /// Per object: the positions of its min and max on every axis (2 * axis + 0 / 1), kept
     /// apart from the boxes so that swaps touch dense memory.
     using Positions = std::array<std::uint32_t, 2 * D>;
@@ -380,6 +400,12 @@ class SweepAndPrune {
     /// thousand each frame, then cost a move in a contiguous array each instead of a
     /// position update of another object.
     ///
+    /// An axis on which no min passed a max needs no pass at all: only the order among ends
+    /// of one kind changed, which no overlap depends on (kindOrderHolds checks it in one
+    /// scan). A resting stack's jitter reorders the tied ends of each layer every frame but
+    /// moves few of them past an end of the other kind; its vertical axis is then left
+    /// as it is, its runs of mins (or maxes) out of order among themselves.
+    ///
     /// Why a batch records every pair whose overlap changed: on each axis the insertion sort
     /// swaps every pair of endpoints whose order changed exactly once, and a swap of a min
     /// and a max is recorded when the other axes overlap by the positions at that moment
@@ -393,6 +419,7 @@ class SweepAndPrune {
         }
         const std::size_t sorted = size_ - pending_.size();
         if (live * kBatchFrom < sorted) {
+            sortAxes();  // moveOne's swaps stop at the first neighbour in order
             for (ObjectId id : moved_) {
                 dirty_[id] = 0;
                 if (state_[id] == State::Sorted) {
@@ -420,9 +447,25 @@ class SweepAndPrune {
                 old = box;
             }
             for (int axis = 0; axis < D; ++axis) {
-                if (changed[axis]) {
-                    insertionPass<0>(axis);
+                if (!changed[axis]) {
+                    continue;
                 }
+                // An axis whose last check failed (a pile: ends of both kinds pass each
+                // other every frame) is checked again only after 8 passes.
+                bool inOrder = false;
+                if (checkAfter_[axis] > 0) {
+                    --checkAfter_[axis];
+                } else if (kindOrderHolds(axis, inOrder)) {
+                    // No min passed a max: no overlap changed on this axis, and the pass
+                    // (which would only reorder ends of one kind) is left out.
+                    sorted_[axis] = inOrder;
+                    ++passesLeftOut_;
+                    continue;
+                } else {
+                    checkAfter_[axis] = 8;
+                }
+                insertionPass<0>(axis);
+                sorted_[axis] = true;
             }
             ++batchedSearches_;
         }
@@ -478,6 +521,53 @@ class SweepAndPrune {
             at_[edges[k].id()][2 * axis + (edges[k].isMax() ? 1 : 0)] = std::uint32_t(k);
         }
         swaps_ += passed;
+    }
+
+    /// Whether `axis` orders every min against every max as their values (and kinds, a min
+    /// first at equal values) do; `inOrder`: whether it is sorted outright. The ends of one
+    /// kind between two ends of the other (a run) may be in any order: one scan checks each
+    /// end against the largest of the run before its own, which by transitivity orders it
+    /// against every end of the other kind.
+    /// Stops at the first end out of that order. Branch-free otherwise: in a pile the
+    /// runs are short and where they end a coin toss.
+    bool kindOrderHolds(int axis, bool& inOrder) const {
+        const std::vector<Endpoint>& edges = axes_[axis];
+        inOrder = true;
+        if (edges.empty()) {
+            return true;
+        }
+        // The first run is checked against a smallest end of the other kind (no end is
+        // before it).
+        Endpoint lastRun = edges[0], run = edges[0];  // the largest of each run
+        std::size_t at = 1;
+        while (at < edges.size() && edges[at].isMax() == edges[0].isMax()) {
+            inOrder &= !before(edges[at], edges[at - 1]);
+            run = before(run, edges[at]) ? edges[at] : run;
+            ++at;
+        }
+        for (; at < edges.size(); ++at) {
+            const Endpoint edge = edges[at];
+            const Endpoint previous = edges[at - 1];
+            inOrder &= !before(edge, previous);
+            const bool newRun = edge.isMax() != previous.isMax();
+            lastRun = newRun ? run : lastRun;
+            run = newRun || before(run, edge) ? edge : run;
+            if (!before(lastRun, edge)) {
+                return false;
+            }
+        }
+        return true;
+    }
+
+    /// Sorts the axes left with unsorted runs (no pair is recorded: only ends of one kind
+    /// swap).
+    void sortAxes() {
+        for (int axis = 0; axis < D; ++axis) {
+            if (!sorted_[axis]) {
+                insertionPass<0>(axis);
+                sorted_[axis] = true;
+            }
+        }
     }
 
     /// Moves one object to `box` in sorted arrays: its endpoints swap their way to the new
@@ -591,6 +681,7 @@ class SweepAndPrune {
     /// least, comparing a merged object with everything open and another with the merged
     /// objects open.
     void merge() {
+        sortAxes();  // the merge needs sorted arrays
         for (ObjectId id : pending_) {
             state_[id] = State::Sorted;
         }
@@ -689,6 +780,10 @@ class SweepAndPrune {
     std::size_t size_ = 0;
     std::size_t dead_ = 0;
     std::size_t swaps_ = 0;
+    std::size_t passesLeftOut_ = 0;
+    /// Per axis: sorted outright (else only each min against each max, see kindOrderHolds).
+    std::array<bool, D> sorted_ = make_filled<true>();
+    std::array<std::uint8_t, D> checkAfter_{};  ///< passes until the axis' next check
     std::size_t changesRecorded_ = 0;
     std::size_t batchedSearches_ = 0;
     std::size_t oneByOneSearches_ = 0;
