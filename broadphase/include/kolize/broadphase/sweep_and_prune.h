@@ -486,11 +486,23 @@ class SweepAndPrune {
                 return;
             }
         }
-        constexpr int axis = kFrom;
+        if (fewSwaps_[kFrom]) {
+            insertionPass<kFrom, true>();
+        } else {
+            insertionPass<kFrom, false>();
+        }
+    }
+
+    /// The pass over `axis`. kWriteEach: each endpoint's position is written as it moves
+    /// (the last pass over this axis moved ends fewer times than half the range it
+    /// rewrote: a stack's sideways jitter); else once over the range that changed, at the
+    /// end (a pile, whose ends pass many others).
+    template <int axis, bool kWriteEach>
+    void insertionPass() {
         // Raw pointers: the arrays do not change size here, and the compiler need not reload
         // them after every store or recorded change.
         Endpoint* const edges = axes_[axis].data();
-        const Positions* const at = at_.data();
+        Positions* const at = at_.data();
         const std::size_t n = axes_[axis].size();
         std::size_t first = n, last = 0, passed = 0;
         for (std::size_t i = 1; i < n; ++i) {
@@ -510,17 +522,26 @@ class SweepAndPrune {
                     ++changesRecorded_;
                 }
                 edges[to] = next;
+                if (kWriteEach) {
+                    at[next.id()][2 * axis + (next.isMax() ? 1 : 0)] = std::uint32_t(to);
+                }
                 --to;
             } while (to > 0 && before(moving, edges[to - 1]));
             passed += i - to;
             edges[to] = moving;
+            if (kWriteEach) {
+                at[id][2 * axis + (isMax ? 1 : 0)] = std::uint32_t(to);
+            }
             first = std::min(first, to);
             last = i;
         }
-        for (std::size_t k = first; k <= last && k < n; ++k) {
-            at_[edges[k].id()][2 * axis + (edges[k].isMax() ? 1 : 0)] = std::uint32_t(k);
+        if (!kWriteEach) {
+            for (std::size_t k = first; k <= last && k < n; ++k) {
+                at[edges[k].id()][2 * axis + (edges[k].isMax() ? 1 : 0)] = std::uint32_t(k);
+            }
         }
         swaps_ += passed;
+        fewSwaps_[axis] = first <= last && 2 * passed < last - first;
     }
 
     /// Whether `axis` orders every min against every max as their values (and kinds, a min
@@ -783,7 +804,9 @@ class SweepAndPrune {
     std::size_t passesLeftOut_ = 0;
     /// Per axis: sorted outright (else only each min against each max, see kindOrderHolds).
     std::array<bool, D> sorted_ = make_filled<true>();
-    std::array<std::uint8_t, D> checkAfter_{};  ///< passes until the axis' next check
+    std::array<std::uint8_t, D> checkAfter_{};
+    std::array<bool, D> fewSwaps_{};  ///< per axis: whether its last pass moved few ends  ///<
+                                      ///< passes until the axis' next check
     std::size_t changesRecorded_ = 0;
     std::size_t batchedSearches_ = 0;
     std::size_t oneByOneSearches_ = 0;
