@@ -3,15 +3,18 @@
 /// SweepAndPrune<D, Scalar>: exact incremental sweep and prune (broadphase "sweep").
 ///
 /// Per axis, one array of the objects' box endpoints sorted by value (a min before a max
-/// of equal value: closed intervals, touching boxes overlap). A moved box's endpoints are
+/// of equal value: closed intervals, touching boxes overlap), except that ends of one kind
+/// between two of the other may be left out of order among themselves (see applyMoves:
+/// every min is still ordered against every max). A moved box's endpoints are
 /// carried to their new places by adjacent swaps, as Bullet's btAxisSweep3 does; a min
 /// passing another object's max (or the reverse) is where the two intervals start or stop
 /// overlapping on that axis, and when their other axes overlap, the pair is recorded as
 /// changed. Moves are applied at the next pair search (maintain()): one object at a time
 /// when under one in eight moved, else one insertion pass per axis (a jittering stack's
-/// tied endpoints swap in a contiguous array, positions written once). Work per frame:
-/// O(moved objects + swaps), plus O(N) per changed axis for a pass; objects at rest cost
-/// nothing, and an axis on which no moved box changed its interval is not touched.
+/// tied endpoints swap in a contiguous array), and none on an axis where no min passed a
+/// max. Work per frame: O(moved objects + swaps), plus O(N) per changed axis for a pass or
+/// its check; objects at rest cost nothing, and an axis on which no moved box changed its
+/// interval is not touched.
 ///
 /// Unlike btAxisSweep3: the endpoints are the exact box coordinates (no quantisation, so no
 /// world bounds and no extra pairs), ids are 32-bit (no 16-bit handle limit), and objects
@@ -22,7 +25,8 @@
 /// from drainChanges and tests only those. A pair appears there whenever the boxes' overlap
 /// may have changed (a superset: each swap of a min and a max of two objects whose other
 /// axes overlap, and every pair of an object merged in). queryBox scans the first axis up
-/// to the box's end, queryRay visits every object: use another core where queries matter.
+/// to the first max past the box's end, queryRay visits every object: use another core
+/// where queries matter.
 
 #include <kolize/broadphase/aabb.h>
 
