@@ -21,11 +21,19 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 header=broadphase/include/kolize/broadphase/sweep_and_prune.h
+axis=broadphase/include/kolize/broadphase/sweep_axis.h  # from ad648a5 on: the axis passes
 rename() {  # distinct names for the two versions in one program
-    sed -e "s/SweepAndPrune/Sweep$1/g; s/sweep_detail/sweep_detail_$1/g; s/SweepSettings/SweepSettings$1/g"
+    sed -e "s/SweepAndPrune/Sweep$1/g; s/sweep_detail/sweep_detail_$1/g; s/SweepSettings/SweepSettings$1/g" \
+        -e "s|kolize/broadphase/sweep_axis.h|sweep_axis_$1.h|"
 }
-git show "$a:$header" | rename A > "$work/A.h"
-git show "$b:$header" | rename B > "$work/B.h"
+for side in A B; do
+    rev=$a
+    [ "$side" = B ] && rev=$b
+    git show "$rev:$header" | rename "$side" > "$work/$side.h"
+    if git cat-file -e "$rev:$axis" 2> /dev/null; then
+        git show "$rev:$axis" | rename "$side" > "$work/sweep_axis_$side.h"
+    fi
+done
 build=${BUILD_DIR:-build}
 g++ -O2 -std=c++17 -DNDEBUG -I"$work" -Ibroadphase/include -Iengine/include -I/usr/include/bullet \
     scripts/sweep-ab/sweep_ab.cpp -o "$work/sweep_ab" "$build/engine/libkolize_engine.a" \

@@ -29,6 +29,7 @@
 /// where queries matter.
 
 #include <kolize/broadphase/aabb.h>
+#include <kolize/broadphase/sweep_axis.h>
 
 #include <algorithm>
 #include <array>
@@ -43,61 +44,6 @@ namespace kolize {
 
 /// Settings of the sweep core (it has none that change its answers).
 struct SweepSettings {};
-
-namespace sweep_detail {
-
-/// One box endpoint in a sorted axis: its value, its object, and whether it is a max. The
-/// order: by value, and a min before a max of equal value (closed intervals: touching boxes
-/// overlap).
-template <class Scalar>
-struct Endpoint {
-    Scalar value_;
-    std::uint32_t code;  ///< id * 2 + (1 for a max)
-
-    static Endpoint make(Scalar value, ObjectId id, bool isMax) {
-        return Endpoint{value, id * 2 + (isMax ? 1u : 0u)};
-    }
-    Scalar value() const { return value_; }
-    void setValue(Scalar value) { value_ = value; }
-    ObjectId id() const { return code >> 1; }
-    bool isMax() const { return (code & 1) != 0; }
-    friend bool before(const Endpoint& a, const Endpoint& b) {
-        return a.value_ < b.value_ || (a.value_ == b.value_ && !a.isMax() && b.isMax());
-    }
-};
-
-/// For float, the order is one integer comparison: the value's bits mapped to an unsigned
-/// that sorts like the value (-0 taken as +0, so that they compare equal), then the max
-/// flag, then the id.
-template <>
-struct Endpoint<float> {
-    std::uint64_t key;
-
-    static std::uint32_t ordered(float value) {
-        std::uint32_t bits;
-        const float canonical = value == 0 ? 0.0f : value;
-        std::memcpy(&bits, &canonical, sizeof bits);
-        return (bits & 0x80000000u) != 0 ? ~bits : bits | 0x80000000u;
-    }
-    static Endpoint make(float value, ObjectId id, bool isMax) {
-        return Endpoint{(std::uint64_t(ordered(value)) << 32) | (isMax ? 0x80000000u : 0u) | id};
-    }
-    float value() const {
-        const std::uint32_t high = std::uint32_t(key >> 32);
-        const std::uint32_t bits = (high & 0x80000000u) != 0 ? high & 0x7fffffffu : ~high;
-        float out;
-        std::memcpy(&out, &bits, sizeof out);
-        return out;
-    }
-    void setValue(float value) {
-        key = (std::uint64_t(ordered(value)) << 32) | (key & 0xffffffffu);
-    }
-    ObjectId id() const { return ObjectId(key & 0x7fffffffu); }
-    bool isMax() const { return (key & 0x80000000u) != 0; }
-    friend bool before(const Endpoint& a, const Endpoint& b) { return a.key < b.key; }
-};
-
-}  // namespace sweep_detail
 
 template <int D, class Scalar>
 class SweepAndPrune {
@@ -305,7 +251,7 @@ class SweepAndPrune {
         for (int axis = 0; axis < D; ++axis) {
             const std::vector<Endpoint>& edges = axes_[axis];
             bool inOrder = true;
-            if (!kindOrderHolds(axis, inOrder)) {
+            if (!sweep_detail::kindOrderHolds(axes_[axis], inOrder)) {
                 fail("axis " + std::to_string(axis) +
                      " orders a min and a max against their values");
             }
@@ -362,9 +308,7 @@ class SweepAndPrune {
         out.fill(kValue);
         return out;
     }
-    /// Per object: the positions of its min and max on every axis (2 * axis + 0 / 1), kept
-    /// apart from the boxes so that swaps touch dense memory.
-    using Positions = std::array<std::uint32_t, 2 * D>;
+    using Positions = sweep_detail::Positions<D>;
     enum class State : std::uint8_t { Absent, Pending, Sorted, Dead };
     struct Change {
         ObjectId a, b;
@@ -377,22 +321,13 @@ class SweepAndPrune {
     /// Whether objects a and b overlap on every axis but `skip`, by the positions of their
     /// endpoints (the arrays' present order, which later swaps start from).
     bool overlapsOnOtherAxes(ObjectId a, ObjectId b, int skip) const {
-        return overlapsOnOtherAxes(at_[a], at_[b], skip);
+        return sweep_detail::overlapsOnOtherAxes<D>(at_[a], at_[b], skip);
     }
 
-    /// Whether the intervals with endpoint positions `first` and `second` overlap on every
-    /// axis but `skip`, and `overlap` (a swap passes whether the two ends differ in kind: one
-    /// chain of ands, as fast as the copies it replaced, where and-ing the result afterwards
-    /// cost the ragdolls' pass 4-6%). Branch-free: in a swap the outcome is a coin toss,
-    /// while a change is recorded for few swaps (with `skip` a constant, as in
-    /// insertionPass, the skipped axis costs nothing).
-    static bool overlapsOnOtherAxes(const Positions& first, const Positions& second, int skip,
-                                    bool overlap = true) {
-        for (int axis = 0; axis < D; ++axis) {
-            overlap &= axis == skip || (first[2 * axis + 1] >= second[2 * axis]) &
-                                           (second[2 * axis + 1] >= first[2 * axis]);
-        }
-        return overlap;
+    /// Records a pair whose overlap may have changed (see drainChanges).
+    void record(ObjectId a, ObjectId b) {
+        changes_.push_back(Change{a, b});
+        ++changesRecorded_;
     }
 
     /// Applies the moves since the last maintain(). Few moved objects (under one in
@@ -459,7 +394,7 @@ class SweepAndPrune {
                 bool inOrder = false;
                 if (checkAfter_[axis] > 0) {
                     --checkAfter_[axis];
-                } else if (kindOrderHolds(axis, inOrder)) {
+                } else if (sweep_detail::kindOrderHolds(axes_[axis], inOrder)) {
                     // No min passed a max: no overlap changed on this axis, and the pass
                     // (which would only reorder ends of one kind) is left out.
                     sorted_[axis] = inOrder;
@@ -476,10 +411,8 @@ class SweepAndPrune {
         moved_.clear();
     }
 
-    /// One insertion sort over `axis`, whose arrays' moved endpoints hold their new values
-    /// at their old places (see applyMoves). The positions on this axis are stale during
-    /// the pass (the overlap tests read the other axes only) and rewritten over the range
-    /// that changed.
+    /// One insertion sort over `which` (sweep_detail::insertionPass), the axis made a
+    /// constant.
     template <int kFrom>
     void insertionPass(int which) {
         // The axis as a constant: the overlap test then reads the other axes' positions of
@@ -490,98 +423,13 @@ class SweepAndPrune {
                 return;
             }
         }
-        if (fewSwaps_[kFrom]) {
-            insertionPass<kFrom, true>();
-        } else {
-            insertionPass<kFrom, false>();
-        }
-    }
-
-    /// The pass over `axis`. kWriteEach: each endpoint's position is written as it moves
-    /// (the last pass over this axis moved ends fewer times than half the range it
-    /// rewrote: a stack's sideways jitter); else once over the range that changed, at the
-    /// end (a pile, whose ends pass many others).
-    template <int axis, bool kWriteEach>
-    void insertionPass() {
-        // Raw pointers: the arrays do not change size here, and the compiler need not reload
-        // them after every store or recorded change.
-        Endpoint* const edges = axes_[axis].data();
-        Positions* const at = at_.data();
-        const std::size_t n = axes_[axis].size();
-        std::size_t first = n, last = 0, passed = 0;
-        for (std::size_t i = 1; i < n; ++i) {
-            if (!before(edges[i], edges[i - 1])) {
-                continue;
-            }
-            const Endpoint moving = edges[i];
-            const ObjectId id = moving.id();
-            const bool isMax = moving.isMax();
-            const Positions mine = at[id];
-            std::size_t to = i;
-            do {
-                const Endpoint next = edges[to - 1];
-                // Branch-free until the rare outcome (see overlapsOnOtherAxes).
-                if (overlapsOnOtherAxes(mine, at[next.id()], axis, next.isMax() != isMax)) {
-                    changes_.push_back(Change{id, next.id()});
-                    ++changesRecorded_;
-                }
-                edges[to] = next;
-                if (kWriteEach) {
-                    at[next.id()][2 * axis + (next.isMax() ? 1 : 0)] = std::uint32_t(to);
-                }
-                --to;
-            } while (to > 0 && before(moving, edges[to - 1]));
-            passed += i - to;
-            edges[to] = moving;
-            if (kWriteEach) {
-                at[id][2 * axis + (isMax ? 1 : 0)] = std::uint32_t(to);
-            }
-            first = std::min(first, to);
-            last = i;
-        }
-        if (!kWriteEach) {
-            for (std::size_t k = first; k <= last && k < n; ++k) {
-                at[edges[k].id()][2 * axis + (edges[k].isMax() ? 1 : 0)] = std::uint32_t(k);
-            }
-        }
-        swaps_ += passed;
-        fewSwaps_[axis] = first <= last && 2 * passed < last - first;
-    }
-
-    /// Whether `axis` orders every min against every max as their values (and kinds, a min
-    /// first at equal values) do; `inOrder`: whether it is sorted outright. The ends of one
-    /// kind between two ends of the other (a run) may be in any order: one scan checks each
-    /// end against the largest of the run before its own, which by transitivity orders it
-    /// against every end of the other kind.
-    /// Stops at the first end out of that order. Branch-free otherwise: in a pile the
-    /// runs are short and where they end a coin toss.
-    bool kindOrderHolds(int axis, bool& inOrder) const {
-        const std::vector<Endpoint>& edges = axes_[axis];
-        inOrder = true;
-        if (edges.empty()) {
-            return true;
-        }
-        // The first run is checked against a smallest end of the other kind (no end is
-        // before it).
-        Endpoint lastRun = edges[0], run = edges[0];  // the largest of each run
-        std::size_t at = 1;
-        while (at < edges.size() && edges[at].isMax() == edges[0].isMax()) {
-            inOrder &= !before(edges[at], edges[at - 1]);
-            run = before(run, edges[at]) ? edges[at] : run;
-            ++at;
-        }
-        for (; at < edges.size(); ++at) {
-            const Endpoint edge = edges[at];
-            const Endpoint previous = edges[at - 1];
-            inOrder &= !before(edge, previous);
-            const bool newRun = edge.isMax() != previous.isMax();
-            lastRun = newRun ? run : lastRun;
-            run = newRun || before(run, edge) ? edge : run;
-            if (!before(lastRun, edge)) {
-                return false;
-            }
-        }
-        return true;
+        auto recordChange = [this](ObjectId a, ObjectId b) { record(a, b); };
+        const sweep_detail::PassResult result =
+            fewSwaps_[kFrom]
+                ? sweep_detail::insertionPass<D, kFrom, true>(axes_[kFrom], at_, recordChange)
+                : sweep_detail::insertionPass<D, kFrom, false>(axes_[kFrom], at_, recordChange);
+        swaps_ += result.passed;
+        fewSwaps_[kFrom] = result.fewSwaps;
     }
 
     /// Sorts the axes left with unsorted runs (no pair is recorded: only ends of one kind
@@ -631,47 +479,15 @@ class SweepAndPrune {
         }
     }
 
-    /// Insertion with a hole: the endpoint at `at` moves down past every endpoint it now
-    /// precedes, each of those one place up. A passed endpoint of the other kind (a min
-    /// passing a max or the reverse) is where two intervals start or stop overlapping on
-    /// this axis: recorded when the other axes overlap. The moving object's positions on the
-    /// other axes do not change meanwhile, so they are read once. Dead objects' endpoints
-    /// (removed, compacted at the next maintain()) are passed like any other; a change they
-    /// take part in is dropped by drainChanges.
-    void sortDown(int axis, std::uint32_t at) { sortAway<-1>(axis, at); }
-    /// The same upwards.
-    void sortUp(int axis, std::uint32_t at) { sortAway<+1>(axis, at); }
-
-    template <int kStep>
-    void sortAway(int axis, std::uint32_t at) {
-        std::vector<Endpoint>& edges = axes_[axis];
-        const Endpoint moving = edges[at];
-        const ObjectId id = moving.id();
-        const bool isMax = moving.isMax();
-        const Positions mine = at_[id];
-        const std::uint32_t end = kStep > 0 ? std::uint32_t(edges.size() - 1) : 0;
-        std::size_t passed = 0;
-        while (at != end) {
-            const Endpoint next = edges[at + kStep];
-            if (!(kStep > 0 ? before(next, moving) : before(moving, next))) {
-                break;
-            }
-            const ObjectId other = next.id();
-            Positions& theirs = at_[other];
-            // Branch-free until the rare outcome: the kinds differ about half the time, at
-            // random, while a change is recorded for few swaps.
-            if (overlapsOnOtherAxes(mine, theirs, axis, next.isMax() != isMax)) {
-                changes_.push_back(Change{id, other});
-                ++changesRecorded_;
-            }
-            edges[at] = next;
-            theirs[2 * axis + (next.isMax() ? 1 : 0)] = at;
-            at += kStep;
-            ++passed;
-        }
-        edges[at] = moving;
-        at_[id][2 * axis + (isMax ? 1 : 0)] = at;
-        swaps_ += passed;
+    /// The endpoint at `at` moves down (up) past every endpoint it now precedes (follows):
+    /// sweep_detail::sortAway.
+    void sortDown(int axis, std::uint32_t at) {
+        swaps_ += sweep_detail::sortAway<D, -1>(axes_[axis], at_, axis, at,
+                                                [this](ObjectId a, ObjectId b) { record(a, b); });
+    }
+    void sortUp(int axis, std::uint32_t at) {
+        swaps_ += sweep_detail::sortAway<D, +1>(axes_[axis], at_, axis, at,
+                                                [this](ObjectId a, ObjectId b) { record(a, b); });
     }
 
     void compact() {
