@@ -25,7 +25,8 @@ namespace {
 using Box = kolize::Aabb<3, float>;
 using Pair = std::pair<kolize::ObjectId, kolize::ObjectId>;
 
-bool overlap(const Box& a, const Box& b) {
+template <class B>
+bool overlap(const B& a, const B& b) {
     for (int axis = 0; axis < 3; ++axis) {
         if (a.hi[axis] < b.lo[axis] || b.hi[axis] < a.lo[axis]) {
             return false;
@@ -36,6 +37,19 @@ bool overlap(const Box& a, const Box& b) {
 
 Pair ordered(kolize::ObjectId a, kolize::ObjectId b) {
     return a < b ? Pair{a, b} : Pair{b, a};
+}
+
+/// A pair search: the drained changes, each tested exactly, kept in `tracked`.
+template <class Core, class B>
+void drainInto(Core& core, const std::vector<B>& boxes, std::set<Pair>& tracked) {
+    core.maintain();
+    core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
+        if (overlap(boxes[a], boxes[b])) {
+            tracked.insert(ordered(a, b));
+        } else {
+            tracked.erase(ordered(a, b));
+        }
+    });
 }
 
 struct Tracked {
@@ -196,16 +210,7 @@ TEST(SweepTracking, ABatchOfTiedJitteringEndpointsKeepsTheExactPairs) {
     kolize::SweepAndPrune<3, float> core;
     std::vector<Box> boxes = unitLayer(core);
     std::set<Pair> tracked;
-    auto drain = [&] {
-        core.maintain();
-        core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
-            if (overlap(boxes[a], boxes[b])) {
-                tracked.insert(ordered(a, b));
-            } else {
-                tracked.erase(ordered(a, b));
-            }
-        });
-    };
+    auto drain = [&] { drainInto(core, boxes, tracked); };
     auto truth = [&] {
         std::set<Pair> out;
         for (kolize::ObjectId a = 0; a < boxes.size(); ++a) {
@@ -302,14 +307,6 @@ void runUnsortedRuns(std::uint32_t seed) {
         box.hi[2] = box.lo[2] + 1;
         return box;
     };
-    auto overlapping = [](const SBox& a, const SBox& b) {
-        for (int axis = 0; axis < 3; ++axis) {
-            if (a.hi[axis] < b.lo[axis] || b.hi[axis] < a.lo[axis]) {
-                return false;
-            }
-        }
-        return true;
-    };
     for (kolize::ObjectId id = 0; id < 128; ++id) {
         boxes[id] = place(id);
         live[id] = true;
@@ -378,18 +375,11 @@ void runUnsortedRuns(std::uint32_t seed) {
                 core.update(id, boxes[id]);
             }
         }
-        core.maintain();
-        core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
-            if (overlapping(boxes[a], boxes[b])) {
-                tracked.insert(ordered(a, b));
-            } else {
-                tracked.erase(ordered(a, b));
-            }
-        });
+        drainInto(core, boxes, tracked);
         std::set<Pair> truth;
         for (kolize::ObjectId a = 0; a < kSlots; ++a) {
             for (kolize::ObjectId b = a + 1; b < kSlots; ++b) {
-                if (live[a] && live[b] && overlapping(boxes[a], boxes[b])) {
+                if (live[a] && live[b] && overlap(boxes[a], boxes[b])) {
                     truth.insert({a, b});
                 }
             }
