@@ -302,10 +302,9 @@ class SweepAndPrune {
 
   private:
     using Endpoint = sweep_detail::Endpoint<Scalar>;
-    template <bool kValue>
-    static std::array<bool, D> make_filled() {
+    static std::array<bool, D> filled(bool value) {
         std::array<bool, D> out;
-        out.fill(kValue);
+        out.fill(value);
         return out;
     }
     using Positions = sweep_detail::Positions<D>;
@@ -335,9 +334,9 @@ class SweepAndPrune {
     /// their places, the arrays sorted after each). Many go in one pass per axis: every
     /// moved endpoint takes its new value where it is, then an insertion sort over the axis
     /// swaps exactly the endpoints whose order changed, and the positions are written once
-    /// at the end. Same-kind endpoints of a stack's layer, which jitter reorders by the
-    /// thousand each frame, then cost a move in a contiguous array each instead of a
-    /// position update of another object.
+    /// at the end (or as each end moves, when the axis' last pass moved few). Same-kind endpoints
+    /// of a stack's layer, which jitter reorders by the thousand each frame, then cost a move in a
+    /// contiguous array each instead of a position update of another object.
     ///
     /// An axis on which no min passed a max needs no pass at all: only the order among ends
     /// of one kind changed, which no overlap depends on (kindOrderHolds checks it in one
@@ -623,10 +622,9 @@ class SweepAndPrune {
     std::size_t swaps_ = 0;
     std::size_t passesLeftOut_ = 0;
     /// Per axis: sorted outright (else only each min against each max, see kindOrderHolds).
-    std::array<bool, D> sorted_ = make_filled<true>();
-    std::array<std::uint8_t, D> checkAfter_{};
-    std::array<bool, D> fewSwaps_{};  ///< per axis: whether its last pass moved few ends  ///<
-                                      ///< passes until the axis' next check
+    std::array<bool, D> sorted_ = filled(true);
+    std::array<std::uint8_t, D> checkAfter_{};  ///< per axis: passes until its next check
+    std::array<bool, D> fewSwaps_{};            ///< per axis: whether its last pass moved few ends
     std::size_t changesRecorded_ = 0;
     std::size_t batchedSearches_ = 0;
     std::size_t oneByOneSearches_ = 0;
