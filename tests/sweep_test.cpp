@@ -39,17 +39,21 @@ Pair ordered(kolize::ObjectId a, kolize::ObjectId b) {
     return a < b ? Pair{a, b} : Pair{b, a};
 }
 
-/// A pair search: the drained changes, each tested exactly, kept in `tracked`.
+/// A pair search: the drained changes, each tested exactly, kept in `tracked`. Returns how
+/// many were drained.
 template <class Core, class B>
-void drainInto(Core& core, const std::vector<B>& boxes, std::set<Pair>& tracked) {
+std::size_t drainInto(Core& core, const std::vector<B>& boxes, std::set<Pair>& tracked) {
+    std::size_t drained = 0;
     core.maintain();
     core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
+        ++drained;
         if (overlap(boxes[a], boxes[b])) {
             tracked.insert(ordered(a, b));
         } else {
             tracked.erase(ordered(a, b));
         }
     });
+    return drained;
 }
 
 struct Tracked {
@@ -134,15 +138,7 @@ Tracked runTracked(std::uint32_t seed, bool lattice, int opsPerFrame, int frames
                 core.update(id, box);
             }
         }
-        core.maintain();
-        core.drainChanges([&](kolize::ObjectId a, kolize::ObjectId b) {
-            ++out.changes;
-            if (overlap(boxes[a], boxes[b])) {
-                tracked.insert(ordered(a, b));
-            } else {
-                tracked.erase(ordered(a, b));
-            }
-        });
+        out.changes += drainInto(core, boxes, tracked);
         std::set<Pair> truth;
         for (int a = 0; a < kObjects; ++a) {
             for (int b = a + 1; b < kObjects; ++b) {

@@ -35,7 +35,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -328,6 +327,10 @@ class SweepAndPrune {
         changes_.push_back(Change{a, b});
         ++changesRecorded_;
     }
+    /// record() as the `record` of sweep_detail's passes.
+    auto recorder() {
+        return [this](ObjectId a, ObjectId b) { record(a, b); };
+    }
 
     /// Applies the moves since the last maintain(). Few moved objects (under one in
     /// kBatchFrom of the sorted ones) go one at a time (moveOne: their endpoints swap to
@@ -422,11 +425,10 @@ class SweepAndPrune {
                 return;
             }
         }
-        auto recordChange = [this](ObjectId a, ObjectId b) { record(a, b); };
         const sweep_detail::PassResult result =
             fewSwaps_[kFrom]
-                ? sweep_detail::insertionPass<D, kFrom, true>(axes_[kFrom], at_, recordChange)
-                : sweep_detail::insertionPass<D, kFrom, false>(axes_[kFrom], at_, recordChange);
+                ? sweep_detail::insertionPass<D, kFrom, true>(axes_[kFrom], at_, recorder())
+                : sweep_detail::insertionPass<D, kFrom, false>(axes_[kFrom], at_, recorder());
         swaps_ += result.passed;
         fewSwaps_[kFrom] = result.fewSwaps;
     }
@@ -481,12 +483,10 @@ class SweepAndPrune {
     /// The endpoint at `at` moves down (up) past every endpoint it now precedes (follows):
     /// sweep_detail::sortAway.
     void sortDown(int axis, std::uint32_t at) {
-        swaps_ += sweep_detail::sortAway<D, -1>(axes_[axis], at_, axis, at,
-                                                [this](ObjectId a, ObjectId b) { record(a, b); });
+        swaps_ += sweep_detail::sortAway<D, -1>(axes_[axis], at_, axis, at, recorder());
     }
     void sortUp(int axis, std::uint32_t at) {
-        swaps_ += sweep_detail::sortAway<D, +1>(axes_[axis], at_, axis, at,
-                                                [this](ObjectId a, ObjectId b) { record(a, b); });
+        swaps_ += sweep_detail::sortAway<D, +1>(axes_[axis], at_, axis, at, recorder());
     }
 
     void compact() {
