@@ -1,0 +1,391 @@
+#include <kolize/broadphase/merged_pair_cache.h>
+
+#include <BulletCollision/BroadphaseCollision/btCollisionAlgorithm.h>
+#include <BulletCollision/BroadphaseCollision/btDispatcher.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace kolize {
+
+namespace {
+
+std::uint32_t biased(int uid) {
+    return static_cast<std::uint32_t>(uid) ^ 0x80000000u;
+}
+
+/// What cleanOverlappingPair does, as Bullet's caches do it.
+void freeAlgorithm(btBroadphasePair& pair, btDispatcher* dispatcher) {
+    if (pair.m_algorithm != nullptr && dispatcher != nullptr) {
+        pair.m_algorithm->~btCollisionAlgorithm();
+        dispatcher->freeCollisionAlgorithm(pair.m_algorithm);
+        pair.m_algorithm = nullptr;
+    }
+}
+
+bool contains(const btBroadphasePair& pair, const btBroadphaseProxy* proxy) {
+    return pair.m_pProxy0 == proxy || pair.m_pProxy1 == proxy;
+}
+
+}  // namespace
+
+void MergedPairCache::sortByKey(std::vector<Order>& order, std::vector<Order>& scratch) {
+    // LSD radix sort, 11 bits a pass: stable, so one key's changes keep the order they were
+    // made in. Digits on which all keys agree (most of a uid's high bits) are skipped.
+    constexpr int kBits = 11;
+    constexpr std::uint64_t kMask = (1u << kBits) - 1;
+    std::uint64_t differ = 0;
+    for (const Order& entry : order) {
+        differ |= entry.key ^ order.front().key;
+    }
+    scratch.resize(order.size());
+    std::vector<std::size_t> start(std::size_t(1) << kBits);
+    for (int shift = 0; shift < 64; shift += kBits) {
+        if (((differ >> shift) & kMask) == 0) {
+            continue;
+        }
+        std::fill(start.begin(), start.end(), 0);
+        for (const Order& entry : order) {
+            ++start[(entry.key >> shift) & kMask];
+        }
+        std::size_t sum = 0;
+        for (std::size_t& count : start) {
+            const std::size_t here = count;
+            count = sum;
+            sum += here;
+        }
+        for (const Order& entry : order) {
+            scratch[start[(entry.key >> shift) & kMask]++] = entry;
+        }
+        order.swap(scratch);
+    }
+}
+
+std::uint64_t MergedPairCache::keyOf(const btBroadphaseProxy* proxy0,
+                                     const btBroadphaseProxy* proxy1) {
+    const int a = proxy0->m_uniqueId, b = proxy1->m_uniqueId;
+    const int lo = a < b ? a : b, hi = a < b ? b : a;
+    return (std::uint64_t(biased(lo)) << 32) | biased(hi);
+}
+
+int MergedPairCache::indexOf(std::uint64_t key) const {
+    const auto it = std::lower_bound(keys_.begin(), keys_.end(), key);
+    return it != keys_.end() && *it == key ? static_cast<int>(it - keys_.begin()) : -1;
+}
+
+bool MergedPairCache::needsBroadphaseCollision(btBroadphaseProxy* proxy0,
+                                               btBroadphaseProxy* proxy1) const {
+    if (filter_ != nullptr) {
+        return filter_->needBroadphaseCollision(proxy0, proxy1);
+    }
+    return (proxy0->m_collisionFilterGroup & proxy1->m_collisionFilterMask) != 0 &&
+           (proxy1->m_collisionFilterGroup & proxy0->m_collisionFilterMask) != 0;
+}
+
+btBroadphasePair* MergedPairCache::addOverlappingPair(btBroadphaseProxy* proxy0,
+                                                      btBroadphaseProxy* proxy1) {
+    if (!needsBroadphaseCollision(proxy0, proxy1)) {
+        return nullptr;
+    }
+    flushTrustedChanges();
+    const std::uint64_t key = keyOf(proxy0, proxy1);
+    const btBroadphasePair fresh(*proxy0, *proxy1);
+    const int at = indexOf(key);
+    if (at >= 0) {
+        btBroadphasePair& pair = pairs_[at];
+        if (isHole(pair)) {  // removed since the last flush: it comes back as a new pair
+            pair = fresh;
+            --tombstones_;
+            ++count_;
+            if (ghost_ != nullptr) {
+                ghost_->addOverlappingPair(fresh.m_pProxy0, fresh.m_pProxy1);
+            }
+        }
+        return &pairs_[at];
+    }
+    const auto waiting = addedIndex_.find(key);
+    if (waiting != addedIndex_.end()) {
+        return &added_[waiting->second].pair;
+    }
+    addedIndex_.emplace(key, static_cast<std::uint32_t>(added_.size()));
+    added_.push_back(Change{key, fresh, nullptr, true});
+    ++count_;
+    if (ghost_ != nullptr) {
+        ghost_->addOverlappingPair(fresh.m_pProxy0, fresh.m_pProxy1);
+    }
+    return &added_.back().pair;
+}
+
+void MergedPairCache::removeAt(int at, btDispatcher* dispatcher) {
+    btBroadphasePair& pair = pairs_[at];
+    freeAlgorithm(pair, dispatcher);
+    btBroadphaseProxy* proxy0 = pair.m_pProxy0;
+    btBroadphaseProxy* proxy1 = pair.m_pProxy1;
+    pair.m_pProxy0 = nullptr;
+    pair.m_pProxy1 = nullptr;
+    firstTombstone_ =
+        tombstones_ == 0 ? std::size_t(at) : std::min(firstTombstone_, std::size_t(at));
+    ++tombstones_;
+    --count_;
+    if (ghost_ != nullptr) {
+        ghost_->removeOverlappingPair(proxy0, proxy1, dispatcher);
+    }
+}
+
+void* MergedPairCache::removeOverlappingPair(btBroadphaseProxy* proxy0, btBroadphaseProxy* proxy1,
+                                             btDispatcher* dispatcher) {
+    flushTrustedChanges();
+    const std::uint64_t key = keyOf(proxy0, proxy1);
+    const int at = indexOf(key);
+    if (at >= 0 && !isHole(pairs_[at])) {
+        void* info = pairs_[at].m_internalInfo1;
+        removeAt(at, dispatcher);
+        return info;
+    }
+    const auto waiting = addedIndex_.find(key);
+    if (waiting == addedIndex_.end()) {
+        return nullptr;
+    }
+    btBroadphasePair& pair = added_[waiting->second].pair;
+    addedIndex_.erase(waiting);
+    freeAlgorithm(pair, dispatcher);
+    void* info = pair.m_internalInfo1;
+    btBroadphaseProxy* first = pair.m_pProxy0;
+    btBroadphaseProxy* second = pair.m_pProxy1;
+    pair.m_pProxy0 = nullptr;
+    pair.m_pProxy1 = nullptr;
+    --count_;
+    if (ghost_ != nullptr) {
+        ghost_->removeOverlappingPair(first, second, dispatcher);
+    }
+    return info;
+}
+
+btBroadphasePair* MergedPairCache::addAbsentPair(btBroadphaseProxy* proxy0,
+                                                 btBroadphaseProxy* proxy1) {
+    changes_.push_back(
+        Change{keyOf(proxy0, proxy1), btBroadphasePair(*proxy0, *proxy1), nullptr, true});
+    ++count_;
+    btBroadphasePair& pair = changes_.back().pair;
+    if (ghost_ != nullptr) {
+        ghost_->addOverlappingPair(pair.m_pProxy0, pair.m_pProxy1);
+    }
+    return &changes_.back().pair;
+}
+
+void MergedPairCache::removePresentPair(btBroadphaseProxy* proxy0, btBroadphaseProxy* proxy1,
+                                        btDispatcher* dispatcher) {
+    changes_.push_back(
+        Change{keyOf(proxy0, proxy1), btBroadphasePair(*proxy0, *proxy1), dispatcher, false});
+    --count_;
+    if (ghost_ != nullptr) {
+        const btBroadphasePair& pair = changes_.back().pair;
+        ghost_->removeOverlappingPair(pair.m_pProxy0, pair.m_pProxy1, dispatcher);
+    }
+}
+
+void MergedPairCache::flush() const {
+    if (walking_ > 0 || (changes_.empty() && added_.empty() && tombstones_ == 0)) {
+        return;
+    }
+    // The changes in key order; among one key's changes, in the order they were made (the
+    // waiting adds came before every trusted change).
+    order_.clear();
+    for (std::size_t i = 0; i < added_.size(); ++i) {
+        if (!isHole(added_[i].pair)) {
+            order_.push_back(Order{added_[i].key, static_cast<std::uint32_t>(i)});
+        }
+    }
+    for (std::size_t i = 0; i < changes_.size(); ++i) {
+        order_.push_back(Order{changes_[i].key, static_cast<std::uint32_t>(added_.size() + i)});
+    }
+    auto before = [](const Order& a, const Order& b) {
+        return a.key < b.key || (a.key == b.key && a.index < b.index);
+    };
+    if (!std::is_sorted(order_.begin(), order_.end(), before)) {
+        if (order_.size() < 4096) {
+            std::sort(order_.begin(), order_.end(), before);
+        } else {
+            sortByKey(order_, orderScratch_);
+        }
+    }
+    auto changeAt = [this](std::uint32_t index) -> Change& {
+        return index < added_.size() ? added_[index] : changes_[index - added_.size()];
+    };
+
+    // Everything before the first changed key stays where it is.
+    std::size_t first = keys_.size();
+    if (!order_.empty()) {
+        first = static_cast<std::size_t>(
+            std::lower_bound(keys_.begin(), keys_.end(), order_.front().key) - keys_.begin());
+    }
+    if (tombstones_ > 0) {
+        first = std::min(first, firstTombstone_);
+    }
+    const std::size_t n = keys_.size(), m = order_.size();
+    mergedKeys_.clear();
+    mergedPairs_.clear();
+    std::size_t i = first, j = 0;
+    while (i < n || j < m) {
+        if (j == m || (i < n && keys_[i] < order_[j].key)) {
+            if (!isHole(pairs_[i])) {
+                mergedKeys_.push_back(keys_[i]);
+                mergedPairs_.push_back(pairs_[i]);
+            }
+            ++i;
+            continue;
+        }
+        const std::uint64_t key = order_[j].key;
+        bool present = false;
+        btBroadphasePair pair;
+        if (i < n && keys_[i] == key) {
+            present = !isHole(pairs_[i]);
+            pair = pairs_[i];
+            ++i;
+        }
+        for (; j < m && order_[j].key == key; ++j) {
+            Change& change = changeAt(order_[j].index);
+            if (change.add && !present) {
+                pair = change.pair;
+                present = true;
+            } else if (!change.add && present) {
+                freeAlgorithm(pair, change.dispatcher);
+                present = false;
+            }
+        }
+        if (present) {
+            mergedKeys_.push_back(key);
+            mergedPairs_.push_back(pair);
+        }
+    }
+    const std::size_t size = first + mergedKeys_.size();
+    keys_.resize(size);
+    std::copy(mergedKeys_.begin(), mergedKeys_.end(), keys_.begin() + std::ptrdiff_t(first));
+    pairs_.resize(static_cast<int>(size));
+    for (std::size_t k = 0; k < mergedPairs_.size(); ++k) {
+        pairs_[static_cast<int>(first + k)] = mergedPairs_[k];
+    }
+    added_.clear();
+    addedIndex_.clear();
+    changes_.clear();
+    tombstones_ = 0;
+    count_ = size;
+}
+
+btBroadphasePair* MergedPairCache::getOverlappingPairArrayPtr() {
+    flush();
+    return pairs_.size() == 0 ? nullptr : &pairs_[0];
+}
+
+const btBroadphasePair* MergedPairCache::getOverlappingPairArrayPtr() const {
+    flush();
+    return pairs_.size() == 0 ? nullptr : &pairs_[0];
+}
+
+btBroadphasePairArray& MergedPairCache::getOverlappingPairArray() {
+    flush();
+    return pairs_;
+}
+
+void MergedPairCache::cleanOverlappingPair(btBroadphasePair& pair, btDispatcher* dispatcher) {
+    freeAlgorithm(pair, dispatcher);
+}
+
+void MergedPairCache::cleanProxyFromPairs(btBroadphaseProxy* proxy, btDispatcher* dispatcher) {
+    flush();
+    for (int at = 0; at < pairs_.size(); ++at) {
+        if (contains(pairs_[at], proxy)) {
+            cleanOverlappingPair(pairs_[at], dispatcher);
+        }
+    }
+}
+
+void MergedPairCache::removeOverlappingPairsContainingProxy(btBroadphaseProxy* proxy,
+                                                            btDispatcher* dispatcher) {
+    flush();
+    ++walking_;
+    for (int at = 0; at < pairs_.size(); ++at) {
+        if (contains(pairs_[at], proxy)) {
+            removeAt(at, dispatcher);
+        }
+    }
+    --walking_;
+    // A waiting pair of the proxy (added by a ghost callback meanwhile) goes too.
+    for (std::size_t k = 0; k < added_.size(); ++k) {
+        const btBroadphasePair pair = added_[k].pair;
+        if (contains(pair, proxy)) {
+            removeOverlappingPair(pair.m_pProxy0, pair.m_pProxy1, dispatcher);
+        }
+    }
+    flush();
+}
+
+void MergedPairCache::visitAll(btOverlapCallback* callback, btDispatcher* dispatcher) {
+    flush();
+    ++walking_;
+    for (int at = pairs_.size() - 1; at >= 0; --at) {
+        if (!isHole(pairs_[at]) && callback->processOverlap(pairs_[at])) {
+            removeAt(at, dispatcher);
+        }
+    }
+    --walking_;
+    if (tombstones_ > 0) {
+        flush();
+    }
+}
+
+void MergedPairCache::processAllOverlappingPairs(btOverlapCallback* callback,
+                                                 btDispatcher* dispatcher) {
+    visitAll(callback, dispatcher);
+}
+
+void MergedPairCache::processAllOverlappingPairs(btOverlapCallback* callback,
+                                                 btDispatcher* dispatcher,
+                                                 const btDispatcherInfo& /*dispatchInfo*/) {
+    visitAll(callback, dispatcher);
+}
+
+btBroadphasePair* MergedPairCache::findPair(btBroadphaseProxy* proxy0, btBroadphaseProxy* proxy1) {
+    flushTrustedChanges();
+    const std::uint64_t key = keyOf(proxy0, proxy1);
+    const int at = indexOf(key);
+    if (at >= 0) {
+        return isHole(pairs_[at]) ? nullptr : &pairs_[at];
+    }
+    const auto waiting = addedIndex_.find(key);
+    return waiting == addedIndex_.end() ? nullptr : &added_[waiting->second].pair;
+}
+
+void MergedPairCache::validate() const {
+    auto fail = [](const std::string& what) {
+        throw std::logic_error("kolize MergedPairCache: " + what);
+    };
+    if (keys_.size() != std::size_t(pairs_.size())) {
+        fail("keys and pairs differ in length");
+    }
+    std::size_t holes = 0;
+    for (std::size_t at = 0; at < keys_.size(); ++at) {
+        if (at > 0 && !(keys_[at - 1] < keys_[at])) {
+            fail("keys not strictly ascending at " + std::to_string(at));
+        }
+        const btBroadphasePair& pair = pairs_[static_cast<int>(at)];
+        if (isHole(pair)) {
+            ++holes;
+            continue;
+        }
+        if (pair.m_pProxy1 == nullptr || keyOf(pair.m_pProxy0, pair.m_pProxy1) != keys_[at] ||
+            pair.m_pProxy0->m_uniqueId > pair.m_pProxy1->m_uniqueId) {
+            fail("pair " + std::to_string(at) + " does not match its key");
+        }
+    }
+    if (holes != tombstones_) {
+        fail("hole count " + std::to_string(holes) + ", recorded " + std::to_string(tombstones_));
+    }
+    if (changes_.empty() && added_.empty() && count_ != keys_.size() - holes) {
+        fail("count " + std::to_string(count_) + " but " + std::to_string(keys_.size() - holes) +
+             " pairs");
+    }
+}
+
+}  // namespace kolize
