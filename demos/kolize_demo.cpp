@@ -55,6 +55,8 @@ const char* kUsage =
     "                            meshes collide (default kolize; kolize-mesh-world compares)\n"
     "  --reference-substeps K    also run each scene with K times the substeps and report\n"
     "                            the bodies' drift from it at the last frame\n"
+    "  --pair-cache hashed|merged  kolize broadphases: Bullet's hashed pair cache (the\n"
+    "                            default) or kolize's MergedPairCache\n"
     "  --fat-margin F            kolize broadphases: fat-box margin, a fraction of each\n"
     "                            box's extent (default 0.05; 0 turns fat boxes off)\n"
     "  --replay-check            record an untimed run of the first broadphase and replay\n"
@@ -84,6 +86,7 @@ struct Options {
     int frames = 200;
     int referenceSubsteps = 0;
     double fatMargin = -1;  ///< < 0: the broadphases' default
+    std::string pairCache;  ///< empty: the broadphases' default
     int replayRounds = 3;
     bool replayCheck = false;
     bool determinism = false;
@@ -168,6 +171,11 @@ Options parse(int argc, char** argv) {
             options.referenceSubsteps = int(kolize::demo::wholeNumber(flag, value, 2, 1000, fail));
         } else if (flag == "--fat-margin") {
             options.fatMargin = kolize::demo::realNumber(flag, value, 0, 10, "a number", fail);
+        } else if (flag == "--pair-cache") {
+            if (value != "merged" && value != "hashed") {
+                fail("--pair-cache takes merged or hashed, got '" + value + "'");
+            }
+            options.pairCache = value;
         } else if (flag == "--record") {
             options.record = value;
         } else if (flag == "--replay") {
@@ -336,6 +344,9 @@ kolize::BroadphaseSettings withOptions(kolize::BroadphaseSettings settings,
                                        const Options& options) {
     if (options.fatMargin >= 0) {
         settings.fatMargin = btScalar(options.fatMargin);
+    }
+    if (!options.pairCache.empty()) {
+        settings.ownPairCache = kolize::pairCacheNamed(options.pairCache);
     }
     return settings;
 }

@@ -24,6 +24,25 @@ namespace {
 
 constexpr btScalar kPlane = btScalar(1e18);
 
+/// A kit parameter: a broadphase name, or a kolize broadphase name + "+merged" for one
+/// that makes a MergedPairCache instead of Bullet's hashed cache.
+constexpr std::string_view kMerged = "+merged";
+bool mergedParam(const std::string& param) {
+    return param.size() > kMerged.size() &&
+           param.compare(param.size() - kMerged.size(), kMerged.size(), kMerged) == 0;
+}
+std::string baseName(const std::string& param) {
+    return mergedParam(param) ? param.substr(0, param.size() - kMerged.size()) : param;
+}
+std::unique_ptr<btBroadphaseInterface> makeFor(const std::string& param) {
+    BroadphaseSettings settings;
+    settings.ownPairCache = mergedParam(param) ? PairCacheChoice::Merged : PairCacheChoice::Hashed;
+    return makeBroadphase(baseName(param), settings);
+}
+bool exactFor(const std::string& param) {
+    return isExactBroadphase(baseName(param));
+}
+
 /// Installed like btGhostPairCallback: sees every add and remove the cache makes.
 class PairRecorder : public btOverlappingPairCallback {
   public:
@@ -97,8 +116,8 @@ struct Counts {
 class RandomScene {
   public:
     RandomScene(const std::string& name, std::uint32_t seed, bool userFilter)
-        : name_(name), exact_(isExactBroadphase(name)), random_(seed) {
-        broadphase_ = makeBroadphase(name);
+        : name_(name), exact_(exactFor(name)), random_(seed) {
+        broadphase_ = makeFor(name);
         cache_ = broadphase_->getOverlappingPairCache();
         cache_->setInternalGhostPairCallback(&recorder_);
         if (userFilter) {
@@ -425,7 +444,7 @@ void runRandomScenes(const std::string& name, bool userFilter) {
         name.c_str(), userFilter ? " + user filter" : "", total.truePairs, total.extraPairs,
         100.0 * double(total.extraPairs) / double(std::max<std::size_t>(total.truePairs, 1)),
         total.extraQueryHits, total.missedNeverMoved, 100 * partnerRate, 100 * hitRate);
-    if (isExactBroadphase(name)) {
+    if (exactFor(name)) {
         EXPECT_EQ(total.missedNeverMoved, 0u);
     }
 }
@@ -439,7 +458,7 @@ TEST_P(Conformance, RandomOperationsWithUserFilterMatchTheOracle) {
 }
 
 TEST_P(Conformance, DestroyRemovesPairsAtOnceAndAddressesAreStable) {
-    auto broadphase = makeBroadphase(GetParam());
+    auto broadphase = makeFor(GetParam());
     btOverlappingPairCache* cache = broadphase->getOverlappingPairCache();
     char clients[2];
     btBroadphaseProxy* a = broadphase->createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), 0,
@@ -454,7 +473,7 @@ TEST_P(Conformance, DestroyRemovesPairsAtOnceAndAddressesAreStable) {
     // A's proxy has not moved and kept its id.
     broadphase->calculateOverlappingPairs(nullptr);
     EXPECT_EQ(a->m_uniqueId, uidA);
-    if (isExactBroadphase(GetParam())) {
+    if (exactFor(GetParam())) {
         // (btAxisSweep3 fails this: it keeps only boxes given to setAabb, not to createProxy.)
         btVector3 lo, hi;
         broadphase->getAabb(a, lo, hi);
@@ -471,7 +490,7 @@ TEST_P(Conformance, RunsInsideADiscreteDynamicsWorld) {
     for (bool plane : {false, true}) {
         SCOPED_TRACE(plane ? "ground plane" : "ground box");
         settings.groundIsPlane = plane;
-        FallingBoxesWorld scene(makeBroadphase(GetParam()), settings);
+        FallingBoxesWorld scene(makeFor(GetParam()), settings);
         btOverlappingPairCache* cache = scene.broadphase().getOverlappingPairCache();
         std::map<UidPair, const btCollisionAlgorithm*> algorithms;
         std::size_t keptAlgorithms = 0;
@@ -481,7 +500,7 @@ TEST_P(Conformance, RunsInsideADiscreteDynamicsWorld) {
             const PairDifference difference =
                 comparePairs(exactPairs(scene.proxyBoxes(), cache), cachedPairs(*cache));
             ASSERT_TRUE(difference.missing.empty()) << "step " << step;
-            if (isExactBroadphase(GetParam())) {
+            if (exactFor(GetParam())) {
                 ASSERT_TRUE(difference.extra.empty()) << "step " << step;
             }
             // Pairs that persist keep their collision algorithm: pairs are not re-created.
@@ -502,7 +521,7 @@ TEST_P(Conformance, RunsInsideADiscreteDynamicsWorld) {
             algorithms.swap(now);
         }
         EXPECT_GT(keptAlgorithms, 100u) << "the stack should rest with persistent contacts";
-        if (isExactBroadphase(GetParam())) {
+        if (exactFor(GetParam())) {
             EXPECT_EQ(replacedAlgorithms, 0u) << "a persisting pair was removed and re-added";
         }
         std::printf(
@@ -527,14 +546,30 @@ TEST_P(Conformance, RunsInsideADiscreteDynamicsWorld) {
     }
 }
 
+std::string paramName(const ::testing::TestParamInfo<std::string>& info) {
+    std::string out;
+    for (char c : info.param) {
+        out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    }
+    return out;
+}
+
 INSTANTIATE_TEST_SUITE_P(AllBroadphases, Conformance, ::testing::ValuesIn(broadphaseNames()),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                             std::string out;
-                             for (char c : info.param) {
-                                 out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-                             }
-                             return out;
-                         });
+                         paramName);
+
+/// kolize's broadphases again, each with a MergedPairCache of its own.
+std::vector<std::string> mergedParams() {
+    std::vector<std::string> out;
+    for (const std::string& name : broadphaseNames()) {
+        if (isExactBroadphase(name)) {
+            out.push_back(name + std::string(kMerged));
+        }
+    }
+    return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(MergedPairCache, Conformance, ::testing::ValuesIn(mergedParams()),
+                         paramName);
 
 }  // namespace
 }  // namespace kolize

@@ -1,4 +1,5 @@
 #include <kolize/broadphase/bullet_adapter.h>
+#include <kolize/broadphase/merged_pair_cache.h>
 
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
 
@@ -88,11 +89,16 @@ BroadphaseAdapter::BroadphaseAdapter(std::string name, const BroadphaseSettings&
                 "btHashedOverlappingPairCache");
         }
         pairCache_ = settings.pairCache;
+    } else if (settings.ownPairCache == PairCacheChoice::Merged) {
+        void* memory = btAlignedAlloc(sizeof(MergedPairCache), 16);
+        pairCache_ = new (memory) MergedPairCache();
+        ownsPairCache_ = true;
     } else {
         void* memory = btAlignedAlloc(sizeof(btHashedOverlappingPairCache), 16);
         pairCache_ = new (memory) btHashedOverlappingPairCache();
         ownsPairCache_ = true;
     }
+    merged_ = dynamic_cast<MergedPairCache*>(pairCache_);
 }
 
 BroadphaseAdapter::~BroadphaseAdapter() {
@@ -217,8 +223,14 @@ void BroadphaseAdapter::uncache(std::uint32_t at, btDispatcher* dispatcher) {
     if (wasCached) {
         --cached_;
         ++counters_.pairsRemoved;
-        pairCache_->removeOverlappingPair(proxyOf(pair.object[0]), proxyOf(pair.object[1]),
-                                          dispatcher);
+        if (merged_ != nullptr && searching_) {
+            // Flushed at the end of the search, while both proxies are still alive.
+            merged_->removePresentPair(proxyOf(pair.object[0]), proxyOf(pair.object[1]),
+                                       dispatcher);
+        } else {
+            pairCache_->removeOverlappingPair(proxyOf(pair.object[0]), proxyOf(pair.object[1]),
+                                              dispatcher);
+        }
     }
 }
 
@@ -851,7 +863,11 @@ void BroadphaseAdapter::applyFilter(std::uint32_t at, bool again, btDispatcher* 
     // A pair that starts overlapping (or a rejected one, looked at again): the cache
     // evaluates the filters, as Bullet's own broadphases let it.
     pair.status = PairStore::Status::Rejected;
-    if (pairCache_->addOverlappingPair(a, b) != nullptr) {
+    const bool added =
+        merged_ != nullptr && searching_
+            ? pairCache_->needsBroadphaseCollision(a, b) && merged_->addAbsentPair(a, b) != nullptr
+            : pairCache_->addOverlappingPair(a, b) != nullptr;
+    if (added) {
         pairs_[at].status = PairStore::Status::InCache;
         ++cached_;
         ++counters_.pairsAdded;
@@ -981,6 +997,9 @@ void BroadphaseAdapter::endSearch(btDispatcher* dispatcher, bool full, std::size
         frameKind_[moved.slot] = 0;
     }
     searching_ = false;
+    if (merged_ != nullptr) {
+        merged_->flush();  // the merge is part of the pair search's time
+    }
     if (deferErasures_ == 0) {
         releasePendingSlots();
     }

@@ -60,6 +60,17 @@ std::string broadphaseNameList() {
     return out;
 }
 
+PairCacheChoice pairCacheNamed(std::string_view name) {
+    if (name == "merged") {
+        return PairCacheChoice::Merged;
+    }
+    if (name == "hashed") {
+        return PairCacheChoice::Hashed;
+    }
+    throw std::invalid_argument("kolize: unknown pair cache '" + std::string(name) +
+                                "'; valid: merged, hashed");
+}
+
 bool isExactBroadphase(std::string_view name) {
     return name == "auto" || name == "grid" || name == "spatial-tree" || name == "spatial-hash" ||
            name == "segment-trees" || name == "range-tree" || name == "sweep" ||

@@ -16,10 +16,16 @@ class Fuzz : public ::testing::TestWithParam<std::string> {};
 TEST_P(Fuzz, RandomProgramsMatchTheModel) {
     const std::string name = GetParam();
     Result total;
-    for (const FilterEvaluation filters :
-         {FilterEvaluation::WhenAdded, FilterEvaluation::EveryFrame}) {
+    // Both filter policies with Bullet's hashed cache, and the default policy with a
+    // MergedPairCache (the pair search hands it changes without lookups).
+    for (const auto& [filters, cache] :
+         {std::pair{FilterEvaluation::WhenAdded, PairCacheChoice::Hashed},
+          std::pair{FilterEvaluation::EveryFrame, PairCacheChoice::Hashed},
+          std::pair{FilterEvaluation::WhenAdded, PairCacheChoice::Merged}}) {
         BroadphaseSettings settings;
         settings.filters = filters;
+        settings.ownPairCache = cache;
+        SCOPED_TRACE(cache == PairCacheChoice::Merged ? "merged pair cache" : "hashed pair cache");
         for (std::uint32_t seed = 1; seed <= 3; ++seed) {
             const std::vector<Op> program = randomProgram(seed, 8000);
             const Result result = run(name, program, settings);

@@ -1,5 +1,6 @@
 // kolize-fuzz: the differential fuzzer on the command line, for soak runs.
 //   kolize-fuzz --broadphase NAME --operations N [--seed S] [--programs P] [--every-frame]
+//               [--merged-cache]
 // Runs P programs of N/P operations (seeds S, S+1, ...), prints one line with operations,
 // searches, queries and mismatches; on the first mismatch prints the seed and the shrunk
 // program as code and exits with 1.
@@ -35,10 +36,12 @@ int main(int argc, char** argv) {
             programs = std::strtoull(value(), nullptr, 10);
         } else if (arg == "--every-frame") {
             settings.filters = kolize::FilterEvaluation::EveryFrame;
+        } else if (arg == "--merged-cache") {
+            settings.ownPairCache = kolize::PairCacheChoice::Merged;
         } else {
             std::fprintf(stderr,
                          "usage: kolize-fuzz --broadphase NAME --operations N [--seed S] "
-                         "[--programs P] [--every-frame]\n");
+                         "[--programs P] [--every-frame] [--merged-cache]\n");
             return 2;
         }
     }

@@ -61,4 +61,9 @@ std::string broadphaseNameList();
 /// True for the names whose pair output is exact (kolize's own broadphases).
 bool isExactBroadphase(std::string_view name);
 
+/// The pair cache named "merged" (kolize::MergedPairCache) or "hashed" (Bullet's
+/// btHashedOverlappingPairCache), for BroadphaseSettings::ownPairCache. Throws
+/// std::invalid_argument for any other name.
+PairCacheChoice pairCacheNamed(std::string_view name);
+
 }  // namespace kolize

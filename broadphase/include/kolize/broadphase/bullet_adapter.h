@@ -50,6 +50,8 @@
 
 namespace kolize {
 
+class MergedPairCache;
+
 /// Counters a kolize broadphase keeps (printStats() prints them).
 struct AdapterStats {
     std::size_t proxies = 0;                   ///< live proxies
@@ -329,6 +331,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     std::string name_;
     BroadphaseSettings settings_;
     btOverlappingPairCache* pairCache_ = nullptr;
+    /// pairCache_ when it is a MergedPairCache: the pair search hands it its changes
+    /// without lookups and flushes it at the end.
+    MergedPairCache* merged_ = nullptr;
     bool ownsPairCache_ = false;
 
     std::vector<std::unique_ptr<Proxy[]>> chunks_;

@@ -48,6 +48,16 @@ enum class FilterEvaluation {
     EveryFrame,
 };
 
+/// The pair cache a kolize broadphase makes for itself when BroadphaseSettings::pairCache
+/// is null.
+enum class PairCacheChoice {
+    /// kolize::MergedPairCache (merged_pair_cache.h): the pair search hands it its changes
+    /// without a lookup, and they are merged into one sorted array once per search.
+    Merged,
+    /// Bullet's btHashedOverlappingPairCache: one hash lookup per added or removed pair.
+    Hashed,
+};
+
 /// Settings for kolize::makeBroadphase. Every field has a usable default.
 struct BroadphaseSettings {
     /// World bounds for Bullet's sweep-and-prune ("sap", "sap-noray", "sap32"). SAP quantises
@@ -63,6 +73,10 @@ struct BroadphaseSettings {
     /// outlive the broadphase. kolize's broadphases need immediate removal and reject a
     /// cache with deferred removal (btSortedOverlappingPairCache) with std::invalid_argument.
     btOverlappingPairCache* pairCache = nullptr;
+    /// The cache kolize's broadphases make when pairCache is null (Bullet's broadphases
+    /// always make Bullet's). Both keep Bullet's contract (merged_pair_cache.h lists the
+    /// differences in order and timing).
+    PairCacheChoice ownPairCache = PairCacheChoice::Hashed;
     /// Called when a kolize broadphase rejects an AABB (NaN, +-inf, or min > max). The proxy
     /// keeps its last valid box; a proxy created with a bad box takes part in no pair until
     /// its first valid setAabb. Empty (the default): print the report's message() on stderr,
