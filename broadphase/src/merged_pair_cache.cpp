@@ -4,6 +4,7 @@
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -95,7 +96,7 @@ btBroadphasePair* MergedPairCache::addOverlappingPair(btBroadphaseProxy* proxy0,
     if (at >= 0) {
         btBroadphasePair& pair = pairs_[at];
         if (isHole(pair)) {  // removed since the last flush: it comes back as a new pair
-            pair = fresh;
+            pair = fresh;    // still listed in holes_: the flush skips it
             --tombstones_;
             ++count_;
             if (ghost_ != nullptr) {
@@ -124,8 +125,7 @@ void MergedPairCache::removeAt(int at, btDispatcher* dispatcher) {
     btBroadphaseProxy* proxy1 = pair.m_pProxy1;
     pair.m_pProxy0 = nullptr;
     pair.m_pProxy1 = nullptr;
-    firstTombstone_ =
-        tombstones_ == 0 ? std::size_t(at) : std::min(firstTombstone_, std::size_t(at));
+    holes_.push_back(std::size_t(at));
     ++tombstones_;
     --count_;
     if (ghost_ != nullptr) {
@@ -189,8 +189,95 @@ void MergedPairCache::flush() const {
     if (walking_ > 0 || (changes_.empty() && added_.empty() && tombstones_ == 0)) {
         return;
     }
-    // The changes in key order; among one key's changes, in the order they were made (the
-    // waiting adds came before every trusted change).
+    sortChanges();
+    auto changeAt = [this](std::uint32_t index) -> Change& {
+        return index < added_.size() ? added_[index] : changes_[index - added_.size()];
+    };
+    // 1. Each key's changes, applied in the order made: a pair in the array is replaced or
+    // becomes a hole in place; a new one is listed for insertion.
+    inserts_.clear();
+    const std::size_t n = keys_.size(), m = order_.size();
+    std::size_t at = 0;
+    for (std::size_t j = 0; j < m;) {
+        const std::uint64_t key = order_[j].key;
+        at = gallop(at, key);
+        const bool inArray = at < n && keys_[at] == key;
+        bool present = inArray && !isHole(pairs_[int(at)]);
+        btBroadphasePair pair = inArray ? pairs_[int(at)] : btBroadphasePair();
+        for (; j < m && order_[j].key == key; ++j) {
+            Change& change = changeAt(order_[j].index);
+            if (change.add && !present) {
+                pair = change.pair;
+                present = true;
+            } else if (!change.add && present) {
+                freeAlgorithm(pair, change.dispatcher);
+                present = false;
+            }
+        }
+        if (inArray) {
+            if (!present && !isHole(pairs_[int(at)])) {
+                holes_.push_back(at);
+            }
+            if (!present) {
+                pair.m_pProxy0 = pair.m_pProxy1 = nullptr;
+            }
+            pairs_[int(at)] = pair;  // a hole revived stays in holes_: skipped below
+        } else if (present) {
+            inserts_.push_back(Insert{at, key, pair});
+        }
+    }
+    // 2. Holes out, moving the runs between them down. An insert's place shifts down by
+    // the holes before it.
+    std::sort(holes_.begin(), holes_.end());
+    std::size_t write = n, removed = 0, hole = 0, insert = 0;
+    for (std::size_t h = 0; h < holes_.size(); ++h) {
+        const std::size_t index = holes_[h];
+        if ((h > 0 && index == holes_[h - 1]) || !isHole(pairs_[int(index)])) {
+            continue;  // listed twice, or revived
+        }
+        for (; insert < inserts_.size() && inserts_[insert].at <= index; ++insert) {
+            inserts_[insert].at -= removed;
+        }
+        if (removed == 0) {
+            write = index;
+        } else {
+            moveRun(hole + 1, index, write);
+            write += index - hole - 1;
+        }
+        hole = index;
+        ++removed;
+    }
+    if (removed > 0) {
+        moveRun(hole + 1, n, write);
+        for (; insert < inserts_.size(); ++insert) {
+            inserts_[insert].at -= removed;
+        }
+    }
+    std::size_t size = n - removed;
+    // 3. Inserts in, from the last, moving the runs between them up.
+    const std::size_t grown = size + inserts_.size();
+    keys_.resize(std::max(size, grown));
+    pairs_.resize(int(std::max(size, grown)));
+    std::size_t end = size;
+    for (std::size_t k = inserts_.size(); k-- > 0;) {
+        const Insert& entry = inserts_[k];
+        moveRun(entry.at, end, entry.at + k + 1);  // [at, end) goes up past k + 1 inserts
+        keys_[entry.at + k] = entry.key;
+        pairs_[int(entry.at + k)] = entry.pair;
+        end = entry.at;
+    }
+    size = grown;
+    holes_.clear();
+    added_.clear();
+    addedIndex_.clear();
+    changes_.clear();
+    tombstones_ = 0;
+    count_ = size;
+}
+
+void MergedPairCache::sortChanges() const {
+    // In key order; among one key's changes, in the order made (the waiting adds came
+    // before every trusted change).
     order_.clear();
     for (std::size_t i = 0; i < added_.size(); ++i) {
         if (!isHole(added_[i].pair)) {
@@ -210,67 +297,32 @@ void MergedPairCache::flush() const {
             sortByKey(order_, orderScratch_);
         }
     }
-    auto changeAt = [this](std::uint32_t index) -> Change& {
-        return index < added_.size() ? added_[index] : changes_[index - added_.size()];
-    };
+}
 
-    // Everything before the first changed key stays where it is.
-    std::size_t first = keys_.size();
-    if (!order_.empty()) {
-        first = static_cast<std::size_t>(
-            std::lower_bound(keys_.begin(), keys_.end(), order_.front().key) - keys_.begin());
+std::size_t MergedPairCache::gallop(std::size_t from, std::uint64_t key) const {
+    // Doubling steps, then a binary search: dense changes cost O(1) each, sparse ones
+    // O(log distance).
+    const std::size_t n = keys_.size();
+    std::size_t step = 1, lo = from;
+    while (lo + step < n && keys_[lo + step] < key) {
+        lo += step;
+        step *= 2;
     }
-    if (tombstones_ > 0) {
-        first = std::min(first, firstTombstone_);
+    const std::size_t hi = std::min(n, lo + step + 1);
+    return static_cast<std::size_t>(std::lower_bound(keys_.begin() + std::ptrdiff_t(lo),
+                                                     keys_.begin() + std::ptrdiff_t(hi), key) -
+                                    keys_.begin());
+}
+
+void MergedPairCache::moveRun(std::size_t from, std::size_t to, std::size_t dest) const {
+    if (from >= to || from == dest) {
+        return;
     }
-    const std::size_t n = keys_.size(), m = order_.size();
-    mergedKeys_.clear();
-    mergedPairs_.clear();
-    std::size_t i = first, j = 0;
-    while (i < n || j < m) {
-        if (j == m || (i < n && keys_[i] < order_[j].key)) {
-            if (!isHole(pairs_[i])) {
-                mergedKeys_.push_back(keys_[i]);
-                mergedPairs_.push_back(pairs_[i]);
-            }
-            ++i;
-            continue;
-        }
-        const std::uint64_t key = order_[j].key;
-        bool present = false;
-        btBroadphasePair pair;
-        if (i < n && keys_[i] == key) {
-            present = !isHole(pairs_[i]);
-            pair = pairs_[i];
-            ++i;
-        }
-        for (; j < m && order_[j].key == key; ++j) {
-            Change& change = changeAt(order_[j].index);
-            if (change.add && !present) {
-                pair = change.pair;
-                present = true;
-            } else if (!change.add && present) {
-                freeAlgorithm(pair, change.dispatcher);
-                present = false;
-            }
-        }
-        if (present) {
-            mergedKeys_.push_back(key);
-            mergedPairs_.push_back(pair);
-        }
-    }
-    const std::size_t size = first + mergedKeys_.size();
-    keys_.resize(size);
-    std::copy(mergedKeys_.begin(), mergedKeys_.end(), keys_.begin() + std::ptrdiff_t(first));
-    pairs_.resize(static_cast<int>(size));
-    for (std::size_t k = 0; k < mergedPairs_.size(); ++k) {
-        pairs_[static_cast<int>(first + k)] = mergedPairs_[k];
-    }
-    added_.clear();
-    addedIndex_.clear();
-    changes_.clear();
-    tombstones_ = 0;
-    count_ = size;
+    const std::size_t count = to - from;
+    std::memmove(static_cast<void*>(keys_.data() + dest), keys_.data() + from,
+                 count * sizeof(std::uint64_t));
+    std::memmove(static_cast<void*>(&pairs_[int(dest)]),
+                 static_cast<const void*>(&pairs_[int(from)]), count * sizeof(btBroadphasePair));
 }
 
 btBroadphasePair* MergedPairCache::getOverlappingPairArrayPtr() {

@@ -143,7 +143,8 @@ class MergedPairCache : public btOverlappingPairCache {
     mutable btBroadphasePairArray pairs_;
     mutable std::vector<std::uint64_t> keys_;
     mutable std::size_t tombstones_ = 0;
-    mutable std::size_t firstTombstone_ = 0;
+    /// Where holes were made (a hole revived since stays listed; repeats possible).
+    mutable std::vector<std::size_t> holes_;
     /// Pairs added through Bullet's interface, waiting: index by key, for their lookups.
     /// A waiting pair removed again has null proxies.
     mutable std::vector<Change> added_;
@@ -155,13 +156,24 @@ class MergedPairCache : public btOverlappingPairCache {
     btOverlapFilterCallback* filter_ = nullptr;
     btOverlappingPairCallback* ghost_ = nullptr;
 
+    /// A pair new to the array, to go in before index `at` (of the array without holes).
+    struct Insert {
+        std::size_t at;
+        std::uint64_t key;
+        btBroadphasePair pair;
+    };
     /// Sorts by key, stably.
     static void sortByKey(std::vector<Order>& order, std::vector<Order>& scratch);
+    /// Fills order_ with the pending changes, sorted.
+    void sortChanges() const;
+    /// The first array index at or after `from` whose key is not below `key`.
+    std::size_t gallop(std::size_t from, std::uint64_t key) const;
+    /// Moves array entries [from, to) (keys and pairs) to start at `dest`.
+    void moveRun(std::size_t from, std::size_t to, std::size_t dest) const;
 
     mutable std::vector<Order> order_;
     mutable std::vector<Order> orderScratch_;
-    mutable std::vector<std::uint64_t> mergedKeys_;
-    mutable std::vector<btBroadphasePair> mergedPairs_;
+    mutable std::vector<Insert> inserts_;
 };
 
 }  // namespace kolize
