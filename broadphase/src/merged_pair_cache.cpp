@@ -101,6 +101,7 @@ btBroadphasePair* MergedPairCache::addOverlappingPair(btBroadphaseProxy* proxy0,
             ++count_;
             if (ghost_ != nullptr) {
                 ghost_->addOverlappingPair(fresh.m_pProxy0, fresh.m_pProxy1);
+                return findPair(proxy0, proxy1);  // the callback may have changed the cache
             }
         }
         return &pairs_[at];
@@ -114,6 +115,7 @@ btBroadphasePair* MergedPairCache::addOverlappingPair(btBroadphaseProxy* proxy0,
     ++count_;
     if (ghost_ != nullptr) {
         ghost_->addOverlappingPair(fresh.m_pProxy0, fresh.m_pProxy1);
+        return findPair(proxy0, proxy1);  // the callback may have changed the cache
     }
     return &added_.back().pair;
 }
@@ -164,23 +166,21 @@ void* MergedPairCache::removeOverlappingPair(btBroadphaseProxy* proxy0, btBroadp
 
 btBroadphasePair* MergedPairCache::addAbsentPair(btBroadphaseProxy* proxy0,
                                                  btBroadphaseProxy* proxy1) {
-    changes_.push_back(
-        Change{keyOf(proxy0, proxy1), btBroadphasePair(*proxy0, *proxy1), nullptr, true});
+    standIn_ = btBroadphasePair(*proxy0, *proxy1);
+    changes_.push_back(Change{keyOf(proxy0, proxy1), standIn_, nullptr, true});
     ++count_;
-    btBroadphasePair& pair = changes_.back().pair;
     if (ghost_ != nullptr) {
-        ghost_->addOverlappingPair(pair.m_pProxy0, pair.m_pProxy1);
+        ghost_->addOverlappingPair(standIn_.m_pProxy0, standIn_.m_pProxy1);
     }
-    return &changes_.back().pair;
+    return &standIn_;
 }
 
 void MergedPairCache::removePresentPair(btBroadphaseProxy* proxy0, btBroadphaseProxy* proxy1,
                                         btDispatcher* dispatcher) {
-    changes_.push_back(
-        Change{keyOf(proxy0, proxy1), btBroadphasePair(*proxy0, *proxy1), dispatcher, false});
+    const btBroadphasePair pair(*proxy0, *proxy1);
+    changes_.push_back(Change{keyOf(proxy0, proxy1), pair, dispatcher, false});
     --count_;
     if (ghost_ != nullptr) {
-        const btBroadphasePair& pair = changes_.back().pair;
         ghost_->removeOverlappingPair(pair.m_pProxy0, pair.m_pProxy1, dispatcher);
     }
 }

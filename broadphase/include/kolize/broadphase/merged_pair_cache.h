@@ -63,7 +63,8 @@ class MergedPairCache : public btOverlappingPairCache {
     btBroadphasePairArray& getOverlappingPairArray() override;
     /// Frees the pair's collision algorithm (as Bullet's caches do).
     void cleanOverlappingPair(btBroadphasePair& pair, btDispatcher* dispatcher) override;
-    /// Exact, without a merge.
+    /// Exact without a merge (given addAbsentPair's and removePresentPair's preconditions;
+    /// a flush makes it exact whatever came before).
     int getNumOverlappingPairs() const override { return static_cast<int>(count_); }
     bool needsBroadphaseCollision(btBroadphaseProxy* proxy0,
                                   btBroadphaseProxy* proxy1) const override;
@@ -90,7 +91,7 @@ class MergedPairCache : public btOverlappingPairCache {
     /// Adds a pair the caller knows is not in the cache, without evaluating the filters
     /// (ask needsBroadphaseCollision first) and without a lookup. Calls the ghost pair
     /// callback now; the pair enters the array at the next flush. Returns a stand-in for
-    /// the pair, valid until the next call.
+    /// the pair (a copy, not the pair itself), valid until the next call.
     btBroadphasePair* addAbsentPair(btBroadphaseProxy* proxy0, btBroadphaseProxy* proxy1);
     /// Removes a pair the caller knows is in the cache, without a lookup. Calls the ghost
     /// pair callback now; the pair's algorithm is freed (through `dispatcher`) and the pair
@@ -174,6 +175,7 @@ class MergedPairCache : public btOverlappingPairCache {
     mutable std::vector<Order> order_;
     mutable std::vector<Order> orderScratch_;
     mutable std::vector<Insert> inserts_;
+    btBroadphasePair standIn_;  ///< what addAbsentPair returns
 };
 
 }  // namespace kolize
