@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <new>
@@ -71,7 +72,9 @@ struct RecordingVisitor : btOverlapCallback {
     bool processOverlap(btBroadphasePair& pair) override {
         const int a = pair.m_pProxy0->m_uniqueId, b = pair.m_pProxy1->m_uniqueId;
         visited.emplace_back(a, b);
-        return rule != 0 && ((a * 7 + b * 3) % rule + rule) % rule == 0;
+        // In 64 bits: the ids include INT_MAX.
+        const std::int64_t mix = std::int64_t(a) * 7 + std::int64_t(b) * 3;
+        return rule != 0 && (mix % rule + rule) % rule == 0;
     }
     int rule;
     std::vector<std::pair<int, int>> visited;
@@ -80,7 +83,8 @@ struct RecordingVisitor : btOverlapCallback {
 /// A filter callback that rejects some pairs by their ids.
 struct IdFilter : btOverlapFilterCallback {
     bool needBroadphaseCollision(btBroadphaseProxy* a, btBroadphaseProxy* b) const override {
-        return ((a->m_uniqueId + b->m_uniqueId) % 4 + 4) % 4 != 1;
+        const std::int64_t sum = std::int64_t(a->m_uniqueId) + b->m_uniqueId;
+        return (sum % 4 + 4) % 4 != 1;
     }
 };
 
