@@ -111,7 +111,7 @@ btBroadphasePair* MergedPairCache::addOverlappingPair(btBroadphaseProxy* proxy0,
         return &added_[waiting->second].pair;
     }
     addedIndex_.emplace(key, static_cast<std::uint32_t>(added_.size()));
-    added_.push_back(Change{key, fresh, nullptr, true});
+    added_.push_back(Waiting{key, fresh});
     ++count_;
     if (ghost_ != nullptr) {
         ghost_->addOverlappingPair(fresh.m_pProxy0, fresh.m_pProxy1);
@@ -167,7 +167,8 @@ void* MergedPairCache::removeOverlappingPair(btBroadphaseProxy* proxy0, btBroadp
 btBroadphasePair* MergedPairCache::addAbsentPair(btBroadphaseProxy* proxy0,
                                                  btBroadphaseProxy* proxy1) {
     standIn_ = btBroadphasePair(*proxy0, *proxy1);
-    changes_.push_back(Change{keyOf(proxy0, proxy1), standIn_, nullptr, true});
+    changes_.push_back(
+        Change{keyOf(proxy0, proxy1), standIn_.m_pProxy0, standIn_.m_pProxy1, nullptr, true});
     ++count_;
     if (ghost_ != nullptr) {
         ghost_->addOverlappingPair(standIn_.m_pProxy0, standIn_.m_pProxy1);
@@ -178,7 +179,8 @@ btBroadphasePair* MergedPairCache::addAbsentPair(btBroadphaseProxy* proxy0,
 void MergedPairCache::removePresentPair(btBroadphaseProxy* proxy0, btBroadphaseProxy* proxy1,
                                         btDispatcher* dispatcher) {
     const btBroadphasePair pair(*proxy0, *proxy1);
-    changes_.push_back(Change{keyOf(proxy0, proxy1), pair, dispatcher, false});
+    changes_.push_back(
+        Change{keyOf(proxy0, proxy1), pair.m_pProxy0, pair.m_pProxy1, dispatcher, false});
     --count_;
     if (ghost_ != nullptr) {
         ghost_->removeOverlappingPair(pair.m_pProxy0, pair.m_pProxy1, dispatcher);
@@ -189,25 +191,43 @@ void MergedPairCache::flush() const {
     if (walking_ > 0 || (changes_.empty() && added_.empty() && tombstones_ == 0)) {
         return;
     }
-    sortChanges();
-    auto changeAt = [this](std::uint32_t index) -> Change& {
-        return index < added_.size() ? added_[index] : changes_[index - added_.size()];
-    };
+    // The changes in key order: changes_ itself when it came sorted and nothing waits
+    // (a full search's changes), else order_.
+    const bool direct = added_.empty() && std::is_sorted(changes_.begin(), changes_.end(),
+                                                         [](const Change& a, const Change& b) {
+                                                             return a.key < b.key;
+                                                         });
+    if (!direct) {
+        sortChanges();
+    }
+    const std::size_t m = direct ? changes_.size() : order_.size();
+    auto keyAt = [&](std::size_t j) { return direct ? changes_[j].key : order_[j].key; };
+    auto indexAt = [&](std::size_t j) { return direct ? j : std::size_t(order_[j].index); };
     // 1. Each key's changes, applied in the order made: a pair in the array is replaced or
     // becomes a hole in place; a new one is listed for insertion.
     inserts_.clear();
-    const std::size_t n = keys_.size(), m = order_.size();
+    const std::size_t n = keys_.size();
     std::size_t at = 0;
     for (std::size_t j = 0; j < m;) {
-        const std::uint64_t key = order_[j].key;
+        const std::uint64_t key = keyAt(j);
         at = gallop(at, key);
         const bool inArray = at < n && keys_[at] == key;
         bool present = inArray && !isHole(pairs_[int(at)]);
         btBroadphasePair pair = inArray ? pairs_[int(at)] : btBroadphasePair();
-        for (; j < m && order_[j].key == key; ++j) {
-            Change& change = changeAt(order_[j].index);
+        for (; j < m && keyAt(j) == key; ++j) {
+            const std::size_t index = indexAt(j);
+            if (index < added_.size()) {  // a waiting add (never of a pair in the array)
+                if (!present) {
+                    pair = added_[index].pair;
+                    present = true;
+                }
+                continue;
+            }
+            const Change& change = changes_[index - added_.size()];
             if (change.add && !present) {
-                pair = change.pair;
+                pair = btBroadphasePair();
+                pair.m_pProxy0 = change.proxy0;
+                pair.m_pProxy1 = change.proxy1;
                 present = true;
             } else if (!change.add && present) {
                 freeAlgorithm(pair, change.dispatcher);

@@ -110,11 +110,18 @@ class MergedPairCache : public btOverlappingPairCache {
     void validate() const;
 
   private:
-    /// A pending change: an add (the fresh pair) or a removal (pair's proxies null).
-    struct Change {
+    /// A pair added through Bullet's interface, waiting for the next flush (the caller may
+    /// have set its algorithm or user data). Null proxies: removed again.
+    struct Waiting {
         std::uint64_t key;
         btBroadphasePair pair;
-        btDispatcher* dispatcher;
+    };
+    /// A change by addAbsentPair / removePresentPair: the pair's proxies, ordered by uid.
+    struct Change {
+        std::uint64_t key;
+        btBroadphaseProxy* proxy0;
+        btBroadphaseProxy* proxy1;
+        btDispatcher* dispatcher;  ///< a removal's; null for an add
         bool add;
     };
     struct Order {
@@ -148,7 +155,7 @@ class MergedPairCache : public btOverlappingPairCache {
     mutable std::vector<std::size_t> holes_;
     /// Pairs added through Bullet's interface, waiting: index by key, for their lookups.
     /// A waiting pair removed again has null proxies.
-    mutable std::vector<Change> added_;
+    mutable std::vector<Waiting> added_;
     mutable std::unordered_map<std::uint64_t, std::uint32_t> addedIndex_;
     /// Changes by addAbsentPair / removePresentPair, in the order made.
     mutable std::vector<Change> changes_;
