@@ -42,7 +42,8 @@ const char* kUsage =
     "Runs scenes with broadphases side by side; checks every frame's pairs against the exact\n"
     "AABB pairs and reports times (medians over frames), errors and the dynamics' health.\n"
     "  --scene NAME|LIST|all     scenes, comma separated (default boxes,boxes-plane)\n"
-    "  --broadphase NAME|LIST|all  broadphases, comma separated (default all)\n"
+    "  --broadphase NAME|LIST|all  broadphases, comma separated (default all); a kolize\n"
+    "                            broadphase may carry :cache=merged or :cache=hashed\n"
     "  --n N                     moving objects (default: the scene's own count)\n"
     "  --frames F                frames per run (default 200)\n"
     "  --seed S                  scene seed (default 1)\n"
@@ -110,6 +111,44 @@ void listScenes() {
     }
 }
 
+/// A --broadphase entry is a name, or a kolize broadphase's name with ":cache=merged" or
+/// ":cache=hashed" (the pair cache it makes), so that both caches run side by side.
+constexpr std::string_view kCacheSetting = ":cache=";
+
+std::string baseName(const std::string& entry) { return entry.substr(0, entry.find(':')); }
+
+kolize::BroadphaseSettings forEntry(kolize::BroadphaseSettings settings, const std::string& entry) {
+    const std::size_t at = entry.find(kCacheSetting);
+    if (at != std::string::npos) {
+        settings.ownPairCache = kolize::pairCacheNamed(entry.substr(at + kCacheSetting.size()));
+    }
+    return settings;
+}
+
+std::vector<std::string> broadphaseEntries(const std::string& flag, const std::string& value,
+                                           kolize::demo::Fail fail) {
+    std::vector<std::string> out;
+    for (const std::string& item : kolize::demo::split(value, ',')) {
+        const std::string base = baseName(item), suffix = item.substr(base.size());
+        if (!suffix.empty()) {
+            const std::string cache = suffix.substr(std::min(suffix.size(), kCacheSetting.size()));
+            if (suffix.compare(0, kCacheSetting.size(), kCacheSetting) != 0 ||
+                (cache != "merged" && cache != "hashed") || !kolize::isExactBroadphase(base)) {
+                fail(flag + ": '" + item + "': a kolize broadphase takes :cache=merged or " +
+                     ":cache=hashed, nothing else");
+            }
+        }
+        for (const std::string& name :
+             kolize::demo::chosen(flag, base, kolize::broadphaseNames(), fail)) {
+            out.push_back(name + suffix);
+        }
+    }
+    if (out.empty()) {
+        fail(flag + " needs at least one name");
+    }
+    return out;
+}
+
 Options parse(int argc, char** argv) {
     Options options;
     for (int i = 1; i < argc; ++i) {
@@ -137,8 +176,7 @@ Options parse(int argc, char** argv) {
         if (flag == "--scene") {
             options.scenes = kolize::demo::chosen(flag, value, sceneNames(), fail);
         } else if (flag == "--broadphase") {
-            options.broadphases =
-                kolize::demo::chosen(flag, value, kolize::broadphaseNames(), fail);
+            options.broadphases = broadphaseEntries(flag, value, fail);
         } else if (flag == "--n") {
             options.scene.objects = int(kolize::demo::wholeNumber(flag, value, 1, 10000000, fail));
         } else if (flag == "--frames") {
@@ -378,14 +416,16 @@ RunResult runScene(const std::string& sceneName, const std::string& name,
         sceneOptions.bulletCcd < 0 ? info.needs.continuous : sceneOptions.bulletCcd > 0;
     r.text("bullet_ccd", !info.needs.dynamics ? "" : ccd ? "on" : "off");
     // Room for the scene's static bodies too (broadphaseSettingsFor gives 64).
-    const std::string skipped = kolize::measurementSkipReason(name, objects + 64);
+    const std::string skipped = kolize::measurementSkipReason(baseName(name), objects + 64);
     if (!skipped.empty()) {
         r.text("status", "skipped: " + skipped);
         return result;
     }
     try {
-        const kolize::BroadphaseSettings settings = settingsFor(info, sceneOptions, options);
-        std::unique_ptr<btBroadphaseInterface> inner = kolize::makeBroadphase(name, settings);
+        const kolize::BroadphaseSettings settings =
+            forEntry(settingsFor(info, sceneOptions, options), name);
+        std::unique_ptr<btBroadphaseInterface> inner =
+            kolize::makeBroadphase(baseName(name), settings);
         std::unique_ptr<btBroadphaseInterface> broadphase;
         if (record != nullptr) {
             broadphase = std::make_unique<kolize::RecordingBroadphase>(*inner, *record);
@@ -646,7 +686,8 @@ std::vector<Record> replayRecords(const kolize::PairStream& stream, const Option
                 continue;
             }
             try {
-                kolize::ReplayResult result = kolize::replay(stream, names[i], settings);
+                kolize::ReplayResult result =
+                    kolize::replay(stream, baseName(names[i]), forEntry(settings, names[i]));
                 frameSeconds[i].push_back(result.medianFrameSeconds());
                 restSeconds[i].push_back(result.medianRestingSeconds());
                 if (round == 0) {
