@@ -385,6 +385,10 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     // --- for "auto": the scene's measure, and a switch of core without losing a pair ---
     /// Starts measuring (motion per setAabb, rays and box queries).
     void startMeasuring() { measuring_ = true; }
+    /// Whether the sampled moves also feed the swap estimate while the core tracks overlaps
+    /// (auto's starting sweep, before its first decision: that decision is made from the
+    /// estimate, as under any other core; a sweep chosen by a decision counts its own).
+    void estimateSwapsWhileTracking(bool estimate) { estimateSwaps_ = estimate; }
     /// A sampled setAabb of `slot` to `to` (boxes_[slot] still the previous box): its motion
     /// and whether it left the object's fat box.
     void noteMotion(ObjectId slot, const Box& to);
@@ -410,6 +414,9 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// searches: every 8 frames, at 2 modulo 8 as the first evaluation (the measure then
     /// holds a new cycle of looked-at moves).
     static bool looksAgainUndecided(std::size_t frame) { return frame % kMotionSampleEvery == 2; }
+    /// Completed pair searches (stats().frames, without the rest of stats(): auto asks
+    /// every frame).
+    std::size_t searches() const { return counters_.frames; }
     /// Whether a move, ray or box query was measured since the last measure.
     bool measuredAny() const {
         return measuredMoves_ > 0 || measuredRays_ > 0 || measuredQueries_ > 0;
@@ -424,6 +431,7 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// frames stood out of a falling world's cheap ones and moved auto's median frame.
     static constexpr std::size_t kMotionSampleEvery = 8;
     bool measuring_ = false;
+    bool estimateSwaps_ = false;  ///< see estimateSwapsWhileTracking
     /// The coming frame's moves of the slots with (slot & spreadMask_) == spreadClass_ are
     /// looked at (none: mask 0, class 1).
     std::size_t spreadMask_ = 0, spreadClass_ = 1;
@@ -496,6 +504,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
         coreTracksOverlaps_ = tracksNow();
         if constexpr (kAuto) {
             startMeasuring();
+            estimateSwapsWhileTracking(true);
         }
     }
 
@@ -610,7 +619,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
     /// "auto": measure, decide, and switch the core when the decision changed.
     void chooseCore(btDispatcher* dispatcher) {
         if constexpr (kAuto) {
-            const std::size_t frame = stats().frames;
+            const std::size_t frame = searches();
             const std::size_t every = std::size_t(std::max(1, coreSettings_.evaluateEvery));
             // Undecided, it looks again every 8 frames once a move, a ray or a query was seen
             // (a world at rest from the start pays only the regular evaluations). Frame 18
@@ -623,6 +632,7 @@ class CoreBroadphase final : public BroadphaseAdapter {
                 return;
             }
             const typename Core::Kind wanted = core_.decide(takeMeasure());
+            estimateSwapsWhileTracking(core_.undecided());
             forgetMoveSamples();
             if (wanted == core_.kind()) {
                 return;
@@ -640,6 +650,9 @@ class CoreBroadphase final : public BroadphaseAdapter {
     void coreReset() override {
         core_ = Core(coreSettings_);
         coreTracksOverlaps_ = tracksNow();  // "auto" starts again on its first core
+        if constexpr (kAuto) {
+            estimateSwapsWhileTracking(true);
+        }
     }
     void coreValidate() const override { core_.validate(); }
     std::size_t coreMemoryBytes() const override { return core_.memoryBytes(); }
