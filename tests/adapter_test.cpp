@@ -924,6 +924,29 @@ std::vector<btScalar> tiedOrSpread(bool tied) {
     return xs;
 }
 
+/// How the x-intervals of unit boxes lie for a slow motion of a tenth of a box: end to end
+/// (x-lows 0 and 1 by turns: a max of one half ties with a min of the other, so a move
+/// passes ends of the other kind by the hundred), tied (every x-low 0: a move passes ends of
+/// its own kind only), or spread (3 apart: a move passes nothing).
+enum class XLayout { EndToEnd, TiedOneKind, Spread };
+
+const char* layoutName(XLayout layout) {
+    return layout == XLayout::EndToEnd      ? "x-intervals end to end"
+           : layout == XLayout::TiedOneKind ? "x-intervals tied at one value"
+                                            : "x-intervals spread apart";
+}
+
+std::vector<btScalar> xLows(XLayout layout) {
+    if (layout != XLayout::EndToEnd) {
+        return tiedOrSpread(layout == XLayout::TiedOneKind);
+    }
+    std::vector<btScalar> xs;
+    for (int i = 0; i < 400; ++i) {
+        xs.push_back(btScalar(i % 2));
+    }
+    return xs;
+}
+
 /// Unit boxes with x-lows xs[i] and y and z on a lattice 1.5 apart, 20 to a row (no two
 /// overlap, whatever their x): created in `broadphase` and recorded in `boxes`.
 std::vector<btBroadphaseProxy*> unitBoxRows(btBroadphaseInterface& broadphase, BoxMap& boxes,
@@ -940,22 +963,24 @@ std::vector<btBroadphaseProxy*> unitBoxRows(btBroadphaseInterface& broadphase, B
     return proxies;
 }
 
-// Slow motion (a tenth of a box per frame) in which every move passes many endpoints: the
-// boxes' x-intervals start at one of two values, so a box that changes value passes about
-// half of each value's ties. A sorted sweep would swap hundreds of endpoints per move; "auto"
-// must see that from an estimate (sampled moves and boxes; its starting sweep's own count
-// leaves out ends of one kind passing each other) and take the grid. The same motion with the
-// boxes' x-intervals spread far apart passes nothing: the sweep. The estimate is checked against a
-// plain count of the swaps: every two x-ends whose order differs before and after the frame (half
+// Slow motion (a tenth of a box per frame) in which every move passes many endpoints of the
+// other kind: the boxes' x-intervals lie end to end, so a box that moves passes about half of
+// the other half's tied ends. The sweep, where auto starts, swaps hundreds of endpoints per
+// move; auto counts them and takes the grid at its first decision. With every x-interval
+// tied at one value, a move passes as many ends, but of its own kind only: no min passes a
+// max, the sweep leaves the axis unsorted and pays nothing for them (counted: 0), and auto
+// keeps it. Spread far apart, the moves pass nothing: the sweep. Under the grid auto
+// estimates the passes from sampled moves and boxes; the estimate is checked against a plain
+// count of the swaps: every two x-ends whose order differs before and after the frame (half
 // for a tie on one side, as a sweep orders ties by id).
 TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
-    for (const bool tied : {true, false}) {
-        SCOPED_TRACE(tied ? "x-intervals tied at two values" : "x-intervals spread apart");
+    for (const XLayout layout : {XLayout::EndToEnd, XLayout::TiedOneKind, XLayout::Spread}) {
+        SCOPED_TRACE(layoutName(layout));
         auto broadphase = makeBroadphase("auto");
         auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
         std::mt19937 random(7);
         std::bernoulli_distribution flip(0.5);
-        const std::vector<btScalar> base = tiedOrSpread(tied);
+        const std::vector<btScalar> base = xLows(layout);
         BoxMap boxes;
         const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
         std::vector<btScalar> xs = base;
@@ -998,18 +1023,27 @@ TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
         const std::string description = adapter.coreDescription();
         ASSERT_GT(moves, 100 * 150);  // the sample means something: most boxes move
         const double plain = counted / moves;
-        const double estimated = passedInDescription(description);
-        if (tied) {
-            EXPECT_GT(plain, 100);  // each move passes about half of the other value's ties
+        const double passed = passedInDescription(description);
+        if (layout == XLayout::EndToEnd) {
+            EXPECT_GT(plain, 100);  // each move passes about half of the other half's ties
             EXPECT_EQ(description.rfind("auto: grid", 0), 0u) << description;
             EXPECT_NE(description.find("would swap much"), std::string::npos) << description;
+            EXPECT_NE(description.find("1 switches"), std::string::npos) << description;
+            // Under the grid, the estimate (samples of moves against each other and against
+            // the boxes that stayed) agrees with the count.
+            EXPECT_EQ(description.find("(counted)"), std::string::npos) << description;
+            EXPECT_NEAR(passed, plain, 0.25 * plain + 1) << description;
         } else {
-            EXPECT_EQ(plain, 0);
             EXPECT_EQ(description.rfind("auto: sweep", 0), 0u) << description;
+            EXPECT_NE(description.find("0 switches"), std::string::npos) << description;
+            EXPECT_NE(description.find("(counted)"), std::string::npos) << description;
+            EXPECT_EQ(passed, 0) << description;
+            if (layout == XLayout::TiedOneKind) {
+                EXPECT_GT(plain, 100);  // a sorted sweep's swaps, which this one leaves out
+            } else {
+                EXPECT_EQ(plain, 0);
+            }
         }
-        // The estimate (samples of moves against each other and against the boxes that
-        // stayed) agrees with the count.
-        EXPECT_NEAR(estimated, plain, 0.25 * plain + 1) << description;
     }
 }
 
@@ -1017,16 +1051,16 @@ TEST(Auto, SlowMotionThatPassesManyEndpointsTakesTheGrid) {
 // float step) tells auto nothing about its motion: it keeps the starting sweep, says so, and
 // looks again every 8 frames, so that its first decision comes from the first
 // motion, at once (not two evaluations of 32 frames later). The motion that follows either
-// passes many tied endpoints (the grid) or none (the sweep). Before this rule the still
-// frames took the sweep, and the tied motion reached the grid only at frame 96.
+// passes many ends of the other kind (the grid) or none (the sweep). Before this rule the
+// still frames decided, and the motion that passed many reached the grid only at frame 96.
 TEST(Auto, AWorldThatStartsStillIsJudgedByItsFirstMotion) {
     for (const bool tied : {true, false}) {
-        SCOPED_TRACE(tied ? "x-intervals tied at two values" : "x-intervals spread apart");
+        SCOPED_TRACE(tied ? "x-intervals end to end" : "x-intervals spread apart");
         auto broadphase = makeBroadphase("auto");
         auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
         std::mt19937 random(21);
         std::bernoulli_distribution flip(0.5);
-        const std::vector<btScalar> base = tiedOrSpread(tied);
+        const std::vector<btScalar> base = xLows(tied ? XLayout::EndToEnd : XLayout::Spread);
         BoxMap boxes;
         const std::vector<btBroadphaseProxy*> proxies = unitBoxRows(*broadphase, boxes, base);
         constexpr int kStill = 21, kDecided = kStill + 9;
@@ -1068,7 +1102,7 @@ TEST(Auto, TheFirstFullWindowCorrectsAGuessFromTwoFrames) {
     auto broadphase = makeBroadphase("auto");
     auto& adapter = dynamic_cast<BroadphaseAdapter&>(*broadphase);
     std::mt19937 random(5);
-    std::uniform_real_distribution<double> fast(-0.5, 0.5);
+    std::uniform_real_distribution<double> fast(-1.5, 1.5);
     std::vector<btBroadphaseProxy*> proxies;
     BoxMap boxes;
     static char client;
@@ -1082,7 +1116,7 @@ TEST(Auto, TheFirstFullWindowCorrectsAGuessFromTwoFrames) {
     for (int frame = 0; frame < 34; ++frame) {
         for (btBroadphaseProxy* proxy : proxies) {
             ProxyBox& box = boxes[proxy];
-            // Half a box per frame at random first; then all drift together by 0.03 of a box
+            // A box and a half per frame at random first; then all drift together by 0.03 of a box
             // (slow, nothing passes anything, every move leaves its fat box: not a jitter).
             const btVector3 step =
                 frame < 3 ? btVector3(btScalar(fast(random)), btScalar(fast(random)), 0)

@@ -453,9 +453,9 @@ void BroadphaseAdapter::noteMotion(ObjectId slot, const Box& to) {
     }
     measuredChanges_ += 1;
     measuredMotion_ += std::min(1e3, motion(from, to) / std::max(size, 1e-30));
-    if (coreTracksOverlaps_ && !estimateSwaps_) {
-        // The tracking core (auto's sweep, once chosen) counts its own swaps, and auto takes
-        // that count (AutoCore::decide): the moves are not sampled for an estimate.
+    if (coreTracksOverlaps_) {
+        // The tracking core (auto's sweep) counts its own swaps, and auto takes that count
+        // (AutoCore::decide): the moves are not sampled for an estimate.
         return;
     }
     // A uniform sample of the moves (reservoir; a fixed-seed generator, so a replayed

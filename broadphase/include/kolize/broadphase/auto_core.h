@@ -34,13 +34,17 @@
 ///   sweep's endpoints swap among the near-equal coordinates of a stack (pyramid, moving
 ///   frames replayed: grid 0.026-0.029 ms, sweep 0.064-0.068);
 /// - slow motion (the moving objects move less than a fifth of their size per frame, as in
-///   most Bullet worlds, resting or settling) in which a sorted sweep would swap much: the
-///   estimated endpoints passed per moved object (SceneMeasure::swapsPerMove, known under
-///   any core; while the sweep runs, its own count replaces the estimate) at least
-///   30 x (1 + half the grid's crowding), under 0.1 pair changes per move: grid. Float
-///   coordinates far from the origin (offset-1e6: 56 passed, counted; the grid 0.8x of the
-///   sweep's time over 300 frames) and boxes settling on a lattice of equal coordinates
-///   (pyramid) pass many equal endpoints that the grid's cells never order;
+///   most Bullet worlds, resting or settling) in which the sweep swaps much: the endpoints
+///   passed per moved object (SceneMeasure::swapsPerMove: while the sweep runs, as it does
+///   from the start, its own count; under another core an estimate) at least
+///   30 x (1 + half the grid's crowding), under 0.1 pair changes per move: grid. The count
+///   is what the sweep pays: an axis on which no min passed a max is not sorted, and ends of
+///   one kind that pass each other there are not counted (the estimate counts every order
+///   change). Since the sweep leaves such axes out, the worlds this rule was fitted on
+///   (offset-1e6's float steps far from the origin, the first frames of bench-1000-stack)
+///   count under 30 and keep the sweep, which there takes less time than the grid (replayed
+///   over 100 frames: offset-1e6's median frame 0.055 ms against 0.063, bench-1000-stack's
+///   frames 2-17 0.05-0.24 ms against 0.16-0.61);
 /// - slow motion otherwise: sweep. (mixed-terrain, mixed-plane and offset-1e4 passed 43-110
 ///   per move in the sweep's old one-by-one updates, most of them ends of boxes falling with
 ///   them that had not moved yet; applied in one pass, mixed-terrain counts 5-27 and the sweep
@@ -66,10 +70,9 @@
 /// and of most of the registry: a world that keeps it pays no switch and no frames on
 /// another core (when auto started on the grid, its two grid frames and its switch to the
 /// sweep sat on the ramp of a world that starts falling and raised its median frame:
-/// mixed-terrain's 1.3x the sweep's over 100 frames, replayed, 1.03x when starting on the
-/// sweep). The first decision (after two pair searches, or later if nothing moved) is made
-/// from the estimated swaps, as under any core, and switches at once: the starting core was
-/// nobody's choice. So does the first decision made from a full
+/// mixed-terrain's, over 100 frames replayed, was 1.3x the sweep's). The first decision
+/// (after two pair searches, or later if nothing moved) switches at once: the starting
+/// core was nobody's choice. So does the first decision made from a full
 /// window (16 frames or more; the first is often made from two; the adapter evaluates at
 /// frame 18, after frames 2-17, and then every 32): a pyramid that jitters is seen as such
 /// from its first full window on. After that a choice must win two evaluations
@@ -165,11 +168,7 @@ class AutoCore {
         // moves against the boxes at this evaluation) misses where a world moved away from
         // the sampled moves (mixed-terrain's falling bodies: estimated 18 per move at frame
         // 32, counted 49 in the frames sampled then).
-        // The starting sweep was nobody's choice: until the first decision the estimate
-        // decides, as under any other core, since the rules were fitted to it (the count
-        // differs: it leaves out the ends of one kind that pass each other on an axis whose
-        // mins and maxes kept their order, which the sweep does not sort).
-        swapsCounted_ = kind_ == Kind::Sweep && evaluations_ > 0 && updates_ > updatesSeen_;
+        swapsCounted_ = kind_ == Kind::Sweep && updates_ > updatesSeen_;
         if (swapsCounted_) {
             measure.swapsPerMove =
                 double(sweep_.swaps() - swapsSeen_) / double(updates_ - updatesSeen_);
@@ -278,8 +277,9 @@ class AutoCore {
     /// 0.019-0.037 pair changes per move: the sweep 0.063, grid 0.073) and
     /// bench-convex-pack's (0.0035-0.0066, 0.0049-0.011); every other scene of the
     /// registry leaves a fat box in over 0.07 of its moves.
-    /// Slow motion with many swaps: the grid when the estimated endpoints passed per moved
-    /// object reach kManySwaps times (1 + half the grid's crowding). A sweep's moved object
+    /// Slow motion with many swaps: the grid when the endpoints passed per moved object
+    /// (counted under the sweep, estimated under the others) reach kManySwaps times (1 +
+    /// half the grid's crowding). A sweep's moved object
     /// costs about 0.07 us + 4 ns per endpoint passed + 0.2 us per pair change (fitted);
     /// the grid's grows with the others beside it. Chosen on 20 recorded streams of the
     /// registry, the features of one 32-frame window against the replayed times of the
@@ -288,7 +288,11 @@ class AutoCore {
     /// others), where the grid took 0.30-0.77x of the sweep's time, and in none where the
     /// sweep was faster; it keeps the sweep for falling boxes (bench-3000-boxes: 39-84
     /// passed, 4-15 others, the sweep 0.55-0.65x of the grid) and bench-prim-mesh (27-36,
-    /// 6-12).
+    /// 6-12). That was fitted before the sweep left out the axes where no min passed a max
+    /// and before auto started on the sweep; now those three worlds count fewer passes and
+    /// keep the sweep, and only ends that pass ends of the other kind by the hundred (x
+    /// intervals that touch end to end, Auto.SlowMotionThatPassesManyEndpointsTakesTheGrid)
+    /// reach the grid.
     static constexpr double kManySwaps = 30;
     /// ... and under this many pair changes per move: every change costs the grid a pair
     /// look where the sweep has found it already (the windows where the grid won had at

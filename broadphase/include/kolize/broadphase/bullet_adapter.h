@@ -385,10 +385,6 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     // --- for "auto": the scene's measure, and a switch of core without losing a pair ---
     /// Starts measuring (motion per setAabb, rays and box queries).
     void startMeasuring() { measuring_ = true; }
-    /// Whether the sampled moves also feed the swap estimate while the core tracks overlaps
-    /// (auto's starting sweep, before its first decision: that decision is made from the
-    /// estimate, as under any other core; a sweep chosen by a decision counts its own).
-    void estimateSwapsWhileTracking(bool estimate) { estimateSwaps_ = estimate; }
     /// A sampled setAabb of `slot` to `to` (boxes_[slot] still the previous box): its motion
     /// and whether it left the object's fat box.
     void noteMotion(ObjectId slot, const Box& to);
@@ -431,7 +427,6 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// frames stood out of a falling world's cheap ones and moved auto's median frame.
     static constexpr std::size_t kMotionSampleEvery = 8;
     bool measuring_ = false;
-    bool estimateSwaps_ = false;  ///< see estimateSwapsWhileTracking
     /// The coming frame's moves of the slots with (slot & spreadMask_) == spreadClass_ are
     /// looked at (none: mask 0, class 1).
     std::size_t spreadMask_ = 0, spreadClass_ = 1;
@@ -504,7 +499,6 @@ class CoreBroadphase final : public BroadphaseAdapter {
         coreTracksOverlaps_ = tracksNow();
         if constexpr (kAuto) {
             startMeasuring();
-            estimateSwapsWhileTracking(true);
         }
     }
 
@@ -632,7 +626,6 @@ class CoreBroadphase final : public BroadphaseAdapter {
                 return;
             }
             const typename Core::Kind wanted = core_.decide(takeMeasure());
-            estimateSwapsWhileTracking(core_.undecided());
             forgetMoveSamples();
             if (wanted == core_.kind()) {
                 return;
@@ -650,9 +643,6 @@ class CoreBroadphase final : public BroadphaseAdapter {
     void coreReset() override {
         core_ = Core(coreSettings_);
         coreTracksOverlaps_ = tracksNow();  // "auto" starts again on its first core
-        if constexpr (kAuto) {
-            estimateSwapsWhileTracking(true);
-        }
     }
     void coreValidate() const override { core_.validate(); }
     std::size_t coreMemoryBytes() const override { return core_.memoryBytes(); }
