@@ -490,7 +490,8 @@ void BroadphaseAdapter::chooseExamined(std::size_t frames) {
     spreadMask_ = 0;
     spreadClass_ = 1;  // none
     countSwapsThisFrame_ = false;
-    if (!measuring_ || (frames > 1 && frames < kMotionSampleEvery)) {
+    if (!measuring_ || (frames > 1 && frames < kMotionSampleEvery) ||
+        liveCount_ - parkedCount_ < sampleFrom_) {
         return;
     }
     if (frames == 1 || frames % kMotionSampleEvery == 0) {
@@ -1051,6 +1052,7 @@ SceneMeasure BroadphaseAdapter::takeMeasure() {
     const double frames = std::max<double>(1, double(measuredFrames_));
     out.frames = double(measuredFrames_);
     out.movedPerFrame = measuredMoves_ / frames;
+    out.movesLookedAt = measuredChanges_;
     out.relativeMotion = measuredChanges_ > 0 ? measuredMotion_ / measuredChanges_ : 0;
     out.fatExitsPerMove = measuredChanges_ > 0 ? measuredFatExits_ / measuredChanges_ : 0;
     const std::size_t pairChanges = counters_.pairsAdded + counters_.pairsRemoved;
