@@ -503,8 +503,9 @@ void BroadphaseAdapter::chooseExamined(std::size_t frames) {
         // The next class (set every 8 frames, at its start): about kExaminedMoves of the
         // objects (the stride the power of two at or above the quotient: from half of them
         // to all).
-        const std::size_t stride =
-            std::max<std::size_t>(1, (liveCount_ - parkedCount_) / kExaminedMoves);
+        const std::size_t stride = std::max<std::size_t>(
+            1, (liveCount_ - parkedCount_) /
+                   (coreTracksOverlaps_ ? kExaminedMovesTracking : kExaminedMoves));
         std::size_t power = 1;
         while (power < stride) {
             power *= 2;

@@ -317,7 +317,7 @@ class AutoCore {
     /// A measure over at least this many frames is a full window (see decide()).
     static constexpr double kFullWindow = 16;
     static constexpr double kJitterFatExits = 0.01;
-    static constexpr double kJitterLookedAt = 64;
+    static constexpr double kJitterLookedAt = 16;
     static constexpr double kJitterPairChanges = 0.002;
 
     /// Fills the sampled fields of `m` if it has a sampler that was not called yet (keeping
