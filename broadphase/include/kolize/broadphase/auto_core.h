@@ -317,6 +317,7 @@ class AutoCore {
     /// A measure over at least this many frames is a full window (see decide()).
     static constexpr double kFullWindow = 16;
     static constexpr double kJitterFatExits = 0.01;
+    /// ... from at least this many moves looked at (see SceneMeasure::movesLookedAt).
     static constexpr double kJitterLookedAt = 16;
     static constexpr double kJitterPairChanges = 0.002;
 

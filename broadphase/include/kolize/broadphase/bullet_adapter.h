@@ -490,9 +490,10 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// Each look is a cache miss or two in a frame that Bullet's narrowphase and solver
     /// leave cold: with 256, auto's median frame was 1.11x the sweep's on mixed-sizes and
     /// escape, with 128 1.05x and 1.08x (their streams replayed with the exact check between
-    /// frames, 5 interleaved rounds, in a harness outside the repository). Fewer would starve
-    /// the jitter rule where few objects move (Auto.CountsEveryMoveUnderTheGridAndUnder
-    /// TheSweep: a fifth of 1200 boxes jitter).
+    /// frames, 5 interleaved rounds, in a harness outside the repository). Fewer would thin
+    /// the jitter rule's evidence where few objects move (a fifth of 1200 boxes jitter in
+    /// Auto.CountsEveryMoveUnderTheGridAndUnderTheSweep: with 128, about 30 looks in its
+    /// first full window).
     static constexpr std::size_t kExaminedMovesTracking = 128;
     double movingSwaps_ = 0;      ///< estimated swaps among moved objects, sampled frames
     double movingSwapMoves_ = 0;  ///< the moves of the frames counted in movingSwaps_
