@@ -237,10 +237,6 @@ class AutoCore {
     }
     void update(ObjectId id, const Box& box) {
         ++updates_;
-        if (kind_ == Kind::Sweep) {  // the usual core, without the dispatch's calls
-            sweep_.update(id, box);
-            return;
-        }
         dispatch([&](auto& core) { core.update(id, box); });
     }
     void remove(ObjectId id) {
