@@ -4,6 +4,8 @@
 // brute-force triangle boxes, and the analytic contact geometry of axis-aligned stacks.
 #include "../box_mesh.h"
 #include "kolize/narrowphase/bullet_mesh.h"
+#include "kolize/narrowphase/mesh_query.h"
+#include "kolize/narrowphase/mesh_stages.h"
 
 #include <btBulletCollisionCommon.h>
 #include <btBulletDynamicsCommon.h>
@@ -11,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <random>
@@ -1178,6 +1181,96 @@ TEST(BulletMeshContacts, CompoundChildrenReachTheMeshAlgorithms) {
     }
     EXPECT_TRUE(convexChild);
     EXPECT_TRUE(meshChild);
+}
+
+/// A square grid of n x n quads of side `side` in the plane z = 0, centred, facing +z.
+TriangleMesh gridMesh(int n, double side) {
+    std::vector<Vec3> vertices;
+    std::vector<Index3> triangles;
+    for (int i = 0; i <= n; ++i) {
+        for (int j = 0; j <= n; ++j) {
+            vertices.emplace_back((i - 0.5 * n) * side, (j - 0.5 * n) * side, 0);
+        }
+    }
+    auto at = [&](int i, int j) { return std::int32_t(i * (n + 1) + j); };
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+            triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    }
+    return TriangleMesh("grid", vertices, triangles);
+}
+
+/// Regression (the wall scene, in a trial): the query takes B's triangles' boxes in A's
+/// frame, and the mesh it used as A was Bullet's body0, i.e. whichever was created first. A
+/// fine mesh created before the box-mesh ground it rests on turned the ground's 10 m
+/// triangles into its own frame, where their boxes meet all of its triangles near them: 2.7x
+/// the exact tests here, 14x in the wall scene. The frame is now the mesh with the larger
+/// triangles, whatever the order, and lastContacts still names body0's triangles X.
+TEST(BulletMeshContacts, TheQueryFrameIsTheCoarserMeshWhateverTheCreationOrder) {
+    auto ground = boxShape(Vec3(5, 5, 0.5));
+    auto grid = std::make_shared<MeshShape>(kolize::makeMeshModel(gridMesh(20, 0.1)));
+    EXPECT_GT(ground->meanTriangleSize(), 50 * grid->meanTriangleSize());
+    // The grid tilted through the ground's top face (z = 0).
+    btTransform tilted = at(0.3, -0.2, 0.05);
+    tilted.setRotation(btQuaternion(btVector3(1, 1, 0).normalized(), btScalar(0.6)));
+    std::uint64_t tests[2] = {0, 0};
+    for (int groundFirst = 0; groundFirst < 2; ++groundFirst) {
+        SCOPED_TRACE(groundFirst ? "ground created first" : "grid created first");
+        World w;
+        btRigidBody* a = w.add(groundFirst ? std::shared_ptr<btCollisionShape>(ground) : grid,
+                               groundFirst ? at(0, 0, -0.5) : tilted, groundFirst ? 0 : 1);
+        btRigidBody* b = w.add(groundFirst ? std::shared_ptr<btCollisionShape>(grid) : ground,
+                               groundFirst ? tilted : at(0, 0, -0.5), groundFirst ? 1 : 0);
+        w.world.performDiscreteCollisionDetection();
+        tests[groundFirst] = kolize::narrowphaseStages(&w.dispatcher).triangle_tests;
+        auto* algorithm = dynamic_cast<kolize::MeshMeshAlgorithm*>(w.algorithm(a, b));
+        ASSERT_NE(algorithm, nullptr);
+        // Bullet's body0 of the pair (the smaller proxy id): the body created first.
+        btBroadphasePair* pair =
+            w.world.getPairCache()->findPair(a->getBroadphaseHandle(), b->getBroadphaseHandle());
+        ASSERT_NE(pair, nullptr);
+        const bool groundIsBody0 =
+            (static_cast<btCollisionObject*>(pair->m_pProxy0->m_clientObject) == a) ==
+            bool(groundFirst);
+        const std::vector<kolize::MeshContact>& contacts = algorithm->lastContacts();
+        ASSERT_FALSE(contacts.empty());
+        for (const kolize::MeshContact& c : contacts) {
+            // X is body0: the normal points from body0 towards body1 (up, out of the ground's
+            // top, when the ground is body0), and X's triangle is one of body0's.
+            const double up = c.normal.z();
+            EXPECT_GT(groundIsBody0 ? up : -up, 0.9);
+            const std::int32_t groundTriangle = groundIsBody0 ? c.triangleX : c.triangleY;
+            const std::int32_t gridTriangle = groundIsBody0 ? c.triangleY : c.triangleX;
+            EXPECT_LT(groundTriangle, 12);
+            EXPECT_GE(gridTriangle, 0);
+            EXPECT_LT(gridTriangle, 800);
+        }
+    }
+    EXPECT_GT(tests[0], 0u);
+    EXPECT_EQ(tests[0], tests[1]);
+    // What the other frame costs (why the choice matters): the same query with the grid as A.
+    kolize::narrowphase::Pose groundPose, gridPose;
+    groundPose.translation = Vec3(0, 0, -0.5);
+    const btMatrix3x3& r = tilted.getBasis();
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            gridPose.rotation(i, j) = r[i][j];
+        }
+    }
+    gridPose.translation = toVec3(tilted.getOrigin());
+    kolize::narrowphase::QuerySettings settings;
+    settings.mode = kolize::narrowphase::QueryMode::kContacts;
+    kolize::narrowphase::MeshQuery query;
+    const std::uint64_t inGround =
+        query.run(ground->model(), groundPose, grid->model(), gridPose, settings)
+            .counters.triangle_tests;
+    const std::uint64_t inGrid =
+        query.run(grid->model(), gridPose, ground->model(), groundPose, settings)
+            .counters.triangle_tests;
+    EXPECT_GT(inGrid, 2 * inGround);
+    EXPECT_EQ(tests[0], inGround);
 }
 
 /// Scaled scenery (btScaledBvhTriangleMeshShape) goes through the same algorithm.

@@ -137,6 +137,9 @@ class MeshShape : public btConcaveShape {
     const std::shared_ptr<const narrowphase::MeshModel>& baseModel() const { return base_; }
     /// Mass properties of the scaled mesh (computed with the model).
     const MeshMassProperties& massProperties() const { return mass_; }
+    /// The mean longest edge of its triangles (scaled model; 0 without triangles). Of two
+    /// meshes, the one with the larger is the frame of their query (MeshMeshAlgorithm).
+    double meanTriangleSize() const { return meanTriangleSize_; }
 
     /// Box around the tree's root volume (scaled model) moved by `t`, cut down to the box
     /// around the moved model-space vertex box (the root OBB of a cube has arbitrary axes),
@@ -171,6 +174,7 @@ class MeshShape : public btConcaveShape {
     narrowphase::Obb root_;                                   ///< the tree's root volume
     narrowphase::Vec3 boundsLo_ = narrowphase::Vec3::Zero();  ///< the vertices' box
     narrowphase::Vec3 boundsHi_ = narrowphase::Vec3::Zero();
+    double meanTriangleSize_ = 0;
 };
 
 /// One contact in the world, before it goes to Bullet: on the meshes X (the first) and Y.
