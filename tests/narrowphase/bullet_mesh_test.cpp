@@ -18,6 +18,7 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 namespace {
@@ -1271,6 +1272,60 @@ TEST(BulletMeshContacts, TheQueryFrameIsTheCoarserMeshWhateverTheCreationOrder) 
             .counters.triangle_tests;
     EXPECT_GT(inGrid, 2 * inGround);
     EXPECT_EQ(tests[0], inGround);
+}
+
+/// A shape rescaled between two queries can swap the query's frame (the mesh with the larger
+/// triangles): the pair's kept traversal front then belongs to the other order. The contacts
+/// after the swap are a fresh pair's, and they still name body0 X: those of the same scene
+/// created in the other order (no swap), with X and Y exchanged.
+TEST(BulletMeshContacts, ARescaledShapeThatSwapsTheQueryFrameGetsAFreshPairsContacts) {
+    auto model = kolize::makeMeshModel(gridMesh(20, 0.1));
+    btTransform crossing = at(0.13, -0.07, 0.02);
+    crossing.setRotation(btQuaternion(btVector3(1, 0.3, 0).normalized(), btScalar(0.9)));
+    const btVector3 bigger(1.01f, 1.01f, 1.01f);
+    auto contactsOf = [&](bool scaledFirst, bool rescaleLater) {
+        World w;
+        auto flat = std::make_shared<MeshShape>(model);
+        auto tilted = std::make_shared<MeshShape>(model);
+        if (!rescaleLater) {
+            tilted->setLocalScaling(bigger);
+        }
+        btRigidBody* a = scaledFirst ? w.add(tilted, crossing, 1) : w.add(flat, at(0, 0, 0), 0);
+        btRigidBody* b = scaledFirst ? w.add(flat, at(0, 0, 0), 0) : w.add(tilted, crossing, 1);
+        for (int i = 0; i < 3; ++i) {
+            w.world.performDiscreteCollisionDetection();  // the front is kept from here on
+        }
+        if (rescaleLater) {
+            EXPECT_EQ(flat->meanTriangleSize(), tilted->meanTriangleSize());  // X = body0
+            tilted->setLocalScaling(bigger);
+            EXPECT_GT(tilted->meanTriangleSize(), flat->meanTriangleSize());  // now X = body1
+            w.world.updateAabbs();
+            w.world.performDiscreteCollisionDetection();
+        }
+        auto* algorithm = dynamic_cast<kolize::MeshMeshAlgorithm*>(w.algorithm(a, b));
+        EXPECT_NE(algorithm, nullptr);
+        return algorithm ? algorithm->lastContacts() : std::vector<kolize::MeshContact>();
+    };
+    const std::vector<kolize::MeshContact> swapped = contactsOf(false, true);
+    const std::vector<kolize::MeshContact> fresh = contactsOf(false, false);
+    const std::vector<kolize::MeshContact> otherOrder = contactsOf(true, false);
+    ASSERT_FALSE(swapped.empty());
+    ASSERT_EQ(swapped.size(), fresh.size());
+    ASSERT_EQ(swapped.size(), otherOrder.size());
+    for (std::size_t i = 0; i < swapped.size(); ++i) {
+        SCOPED_TRACE("contact " + std::to_string(i));
+        const kolize::MeshContact &s = swapped[i], &f = fresh[i], &o = otherOrder[i];
+        EXPECT_EQ(s.point, f.point);
+        EXPECT_EQ(s.normal, f.normal);
+        EXPECT_EQ(s.depth, f.depth);
+        EXPECT_EQ(s.triangleX, f.triangleX);
+        EXPECT_EQ(s.triangleY, f.triangleY);
+        EXPECT_EQ(s.point, o.point);
+        EXPECT_EQ(s.normal, Vec3(-o.normal));
+        EXPECT_EQ(s.depth, o.depth);
+        EXPECT_EQ(s.triangleX, o.triangleY);
+        EXPECT_EQ(s.triangleY, o.triangleX);
+    }
 }
 
 /// Scaled scenery (btScaledBvhTriangleMeshShape) goes through the same algorithm.
