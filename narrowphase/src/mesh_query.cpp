@@ -264,8 +264,8 @@ bool outside(const Vec3& plo, const Vec3& phi, const Vec3& lo, const Vec3& hi, d
 
 /// Every triangle pair of a leaf pair.
 template <class Node>
-void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const NodeLink& la,
-              const NodeLink& lb) {
+void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, std::int32_t firstA,
+              int countA, const NodeLink& lb) {
     ++c.counters.leaf_pairs;
     constexpr int kMax = 8;  // BvTree's largest leaf
     Triangle qs[kMax];
@@ -294,8 +294,8 @@ void leafPair(Context& c, const BvTree<Node>& ta, const BvTree<Node>& tb, const 
     const double m = c.margin;
     std::int32_t met[kMax];
     const std::vector<Vec3>& va = c.a.mesh().vertices();
-    for (int i = 0; i < la.count(); ++i) {
-        const std::int32_t slotA = la.firstSlot() + i;
+    for (int i = 0; i < countA; ++i) {
+        const std::int32_t slotA = firstA + i;
         const Index3& ti = ta.slotTriangles()[slotA];
         const Triangle p = {va[ti[0]], va[ti[1]], va[ti[2]]};
         const Vec3 plo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
@@ -563,6 +563,9 @@ const QueryResult& finish(Context& c, QueryResult& result) {
     return result;
 }
 
+/// See traverse: meshes of at most this many triangles are one leaf (a box mesh has 12).
+constexpr std::size_t kWholeLeaf = 16;
+
 template <class Node, class Ops>
 void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFront) {
     const BvTree<Node>& ta = c.a.template tree<Node>();
@@ -583,6 +586,12 @@ void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFr
         stack.push_back(NodePair(0, 0, detail::kNoAxis));
     }
     c.counters.front_size = stack.size();
+    // A mesh of at most kWholeLeaf triangles is one leaf here: its tree is not descended, and
+    // each B leaf meets all of its triangles (their boxes first, in A's frame). A box mesh's
+    // leaves all have the whole box as their volume, however its 12 triangles are split, so
+    // a body resting on a box-mesh ground was traversed once per ground leaf (4 times).
+    const bool wholeA = c.a.mesh().triangleCount() <= kWholeLeaf;
+    const int countA = int(c.a.mesh().triangleCount());
     const bool larger = c.settings.descent != Descent::kFirstThenSecond;
     const bool both = c.settings.descent == Descent::kBoth;
     const bool yesNo = c.settings.mode == QueryMode::kYesNo;
@@ -603,17 +612,18 @@ void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFr
             continue;
         }
         const NodeLink la = na[ia].link, lb = nb[ib].link;
-        if (la.isLeaf() && lb.isLeaf()) {
+        const bool leafA = wholeA || la.isLeaf();
+        if (leafA && lb.isLeaf()) {
             if (recordFront) {
                 next.push_back(NodePair(ia, ib, detail::kNoAxis));
             }
-            leafPair(c, ta, tb, la, lb);
+            leafPair(c, ta, tb, wholeA ? 0 : la.firstSlot(), wholeA ? countA : la.count(), lb);
             if (c.stop) {
                 break;
             }
             continue;
         }
-        if (both && !la.isLeaf() && !lb.isLeaf()) {
+        if (both && !leafA && !lb.isLeaf()) {
             const std::int32_t a2 = la.right(), b2 = lb.right();
             NodePair children[4] = {
                 NodePair(ia + 1, ib + 1, detail::kNoAxis), NodePair(ia + 1, b2, detail::kNoAxis),
@@ -637,8 +647,7 @@ void traverse(Context& c, MeshQuery::Front* front, bool fromFront, bool recordFr
             }
             continue;
         }
-        const bool descendA =
-            !la.isLeaf() && (lb.isLeaf() || !larger || na[ia].size() >= nb[ib].size());
+        const bool descendA = !leafA && (lb.isLeaf() || !larger || na[ia].size() >= nb[ib].size());
         NodePair first = descendA ? NodePair(ia + 1, ib, detail::kNoAxis)
                                   : NodePair(ia, ib + 1, detail::kNoAxis);
         NodePair second = descendA ? NodePair(la.right(), ib, detail::kNoAxis)

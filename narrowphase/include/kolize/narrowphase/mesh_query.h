@@ -7,7 +7,9 @@
 ///  2. tree against tree (or, `use_tree` off, every triangle pair directly): an iterative traversal
 ///  of the two bounding-volume trees, node
 ///     pairs tested with the kind's overlap test (OBB: a node-sphere test first, when
-///     `sphere_pretest`, then the 15-axis separating-axis test);
+///     `sphere_pretest`, then the 15-axis separating-axis test). An A of at most 16
+///     triangles is one leaf (its tree is not descended): a box mesh's leaves all have the
+///     whole box as their volume, and each would take B's traversal once more;
 ///  3. leaf pairs: B's leaf vertices transformed into A's frame (once per query, cached),
 ///     a box test of every triangle pair (exact, on double boxes), the optional facing
 ///     filter, then the exact triangle test.
