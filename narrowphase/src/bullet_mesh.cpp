@@ -208,6 +208,31 @@ struct ContactScratch {
     std::vector<int> insideOfA, insideOfB;  // a vertex's entry in `inside`, -1 between calls
     std::vector<const PairContact*> sorted;
     std::vector<const NearPair*> sortedNear;
+    std::vector<Vec3> outA, outB;  // each sorted pair's outward face normals (A's frame)
+    // B's vertices in A's frame, each moved once per call: valid where bStamp == stamp.
+    std::vector<Vec3> bInAVertices;
+    std::vector<std::uint32_t> bStamp;
+    std::uint32_t stamp = 0;
+
+    /// Starts a call on a B mesh of `vertexCount` vertices: forgets every moved vertex.
+    void newCall(std::size_t vertexCount) {
+        if (bStamp.size() < vertexCount) {
+            bStamp.resize(vertexCount, 0);
+            bInAVertices.resize(vertexCount);
+        }
+        if (++stamp == 0) {  // wrapped: forget the old stamps once every 2^32 calls
+            std::fill(bStamp.begin(), bStamp.end(), 0);
+            stamp = 1;
+        }
+    }
+    /// B's vertex v in A's frame, bInA.apply(v) (the same doubles), computed once per call.
+    const Vec3& vertexB(std::int32_t v, const TriangleMesh& meshB, const RelativePose& bInA) {
+        if (bStamp[v] != stamp) {
+            bStamp[v] = stamp;
+            bInAVertices[v] = bInA.apply(meshB.vertices()[v]);
+        }
+        return bInAVertices[v];
+    }
 };
 
 /// How a mesh's face normals say which side is outside.
@@ -243,15 +268,21 @@ Vec3 outward(const Vec3& n, Sides sides, const TriangleMesh& mesh, const Index3&
 void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const TriangleMesh& meshB,
                     const RelativePose& bInA, Sides sidesA, Sides sidesB, ContactScratch& s);
 
+/// Whether depthBelow can find a depth along d below a triangle of outward unit normal m:
+/// not when the line along d runs within 1e-3 of the plane's direction or leaves it.
+bool movesOutThrough(const Vec3& d, const Vec3& m) {
+    return !(d.dot(m) > -1e-3);
+}
+
 /// How far `v` lies inside a mesh below its triangle (q0, q1, q2) with outward unit normal
-/// `m`, measured along -d (d unit, the direction the mesh moves out): t >= 0 with v - t d in
-/// the closed triangle and v behind or on its plane; -1 when v is in front, the line along d
-/// runs within 1e-3 of the plane's direction, or passes beside the triangle.
+/// `m`, measured along -d (d unit, the direction the mesh moves out; movesOutThrough(d, m)):
+/// t >= 0 with v - t d in the closed triangle and v behind or on its plane; -1 when v is in
+/// front or the line passes beside the triangle.
 double depthBelow(const Vec3& v, const Vec3& d, const Vec3& q0, const Vec3& q1, const Vec3& q2,
                   const Vec3& m) {
     const double behind = (v - q0).dot(m);
     const double along = d.dot(m);
-    if (behind > 0 || along > -1e-3) {
+    if (behind > 0) {
         return -1;
     }
     const double t = behind / along;
@@ -297,13 +328,18 @@ bool spansArea(const std::vector<Candidate>& candidates, std::size_t first) {
 void insideVertices(const PairContact& c, int patch, const Vec3& n, const Vec3& normalA,
                     const Vec3& normalB, const TriangleMesh& meshA, const TriangleMesh& meshB,
                     const RelativePose& bInA, ContactScratch& s) {
+    // Each direction is tested once per pair: along it every vertex or none can have a depth.
+    const bool throughB = movesOutThrough(n, normalB);
+    const bool throughA = movesOutThrough(-n, normalA);
+    if (!throughA && !throughB) {
+        return;
+    }
     const Index3& ia = meshA.triangles()[c.pair.a];
     const Index3& ib = meshB.triangles()[c.pair.b];
     const std::array<Vec3, 3> a = {meshA.vertices()[ia[0]], meshA.vertices()[ia[1]],
                                    meshA.vertices()[ia[2]]};
-    const std::array<Vec3, 3> b = {bInA.apply(meshB.vertices()[ib[0]]),
-                                   bInA.apply(meshB.vertices()[ib[1]]),
-                                   bInA.apply(meshB.vertices()[ib[2]])};
+    const std::array<Vec3, 3> b = {s.vertexB(ib[0], meshB, bInA), s.vertexB(ib[1], meshB, bInA),
+                                   s.vertexB(ib[2], meshB, bInA)};
     auto keep = [&](int& slot, const Vec3& point, double depth) {
         if (depth < 0) {
             return;
@@ -318,10 +354,14 @@ void insideVertices(const PairContact& c, int patch, const Vec3& n, const Vec3& 
     // A moves out of B along -n: A's vertex v meets B's face at v - t n; the contact point
     // is halfway, v - (t/2) n. B moves out along +n.
     for (int k = 0; k < 3; ++k) {
-        const double t = depthBelow(a[k], n, b[0], b[1], b[2], normalB);
-        keep(s.insideOfA[ia[k]], a[k] - (0.5 * t) * n, t);
-        const double u = depthBelow(b[k], -n, a[0], a[1], a[2], normalA);
-        keep(s.insideOfB[ib[k]], b[k] + (0.5 * u) * n, u);
+        if (throughB) {
+            const double t = depthBelow(a[k], n, b[0], b[1], b[2], normalB);
+            keep(s.insideOfA[ia[k]], a[k] - (0.5 * t) * n, t);
+        }
+        if (throughA) {
+            const double u = depthBelow(b[k], -n, a[0], a[1], a[2], normalA);
+            keep(s.insideOfB[ib[k]], b[k] + (0.5 * u) * n, u);
+        }
     }
 }
 
@@ -429,6 +469,18 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
     if (s.insideOfB.size() < meshB.vertices().size()) {
         s.insideOfB.resize(meshB.vertices().size(), -1);
     }
+    // Each pair's face normals, turned outward, once (the patch's normals and its inside
+    // vertices both need them); B's origin in A's frame is an open B's centre.
+    s.newCall(meshB.vertices().size());
+    const Vec3 originB = bInA.apply(Vec3::Zero());
+    s.outA.resize(count);
+    s.outB.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const PairContact& c = *pairs[i];
+        s.outA[i] =
+            outward(c.normal_a, sidesA, meshA, meshA.triangles()[c.pair.a], nullptr, Vec3::Zero());
+        s.outB[i] = outward(c.normal_b, sidesB, meshB, meshB.triangles()[c.pair.b], &bInA, originB);
+    }
     unionByVertex(
         count, [&](std::size_t i, int k) { return meshA.triangles()[pairs[i]->pair.a][k]; },
         s.parent, s.lastPair);
@@ -474,9 +526,8 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
             const double weight = c.geometry.kind == TriangleIntersection::Kind::kPolygon
                                       ? std::sqrt(measure)
                                       : measure;
-            const Vec3 normalA = outward(c.normal_a, sidesA, meshA, ia, nullptr, Vec3::Zero());
-            const Vec3 normalB =
-                outward(c.normal_b, sidesB, meshB, ib, &bInA, bInA.apply(Vec3::Zero()));
+            const Vec3& normalA = s.outA[s.order[k]];
+            const Vec3& normalB = s.outB[s.order[k]];
             sum += weight * (normalA - normalB);
             // One entry per triangle, at its heaviest pair's weight (a triangle's normal is
             // the same in every pair it is in).
@@ -523,7 +574,7 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
         }
         s.pointsB.clear();
         for (std::int32_t v : s.verticesB) {
-            s.pointsB.push_back(bInA.apply(meshB.vertices()[v]));
+            s.pointsB.push_back(s.vertexB(v, meshB, bInA));
         }
         // The candidate along which the patch's pieces overlap least (the separating-axis
         // idea on the touched triangles): its overlap is the depth. The smaller side is
@@ -579,12 +630,8 @@ void patchesOfPairs(const QueryResult& result, const TriangleMesh& meshA, const 
             const std::size_t first = s.inside.size();
             for (std::size_t k = begin; k < end; ++k) {
                 const PairContact& c = *pairs[s.order[k]];
-                insideVertices(c, root, patch.normal,
-                               outward(c.normal_a, sidesA, meshA, meshA.triangles()[c.pair.a],
-                                       nullptr, Vec3::Zero()),
-                               outward(c.normal_b, sidesB, meshB, meshB.triangles()[c.pair.b],
-                                       &bInA, bInA.apply(Vec3::Zero())),
-                               meshA, meshB, bInA, s);
+                insideVertices(c, root, patch.normal, s.outA[s.order[k]], s.outB[s.order[k]], meshA,
+                               meshB, bInA, s);
             }
             for (std::size_t k = begin; k < end; ++k) {
                 const PairContact& c = *pairs[s.order[k]];
