@@ -1063,6 +1063,13 @@ struct MeshContactAlgorithm::State {
     std::vector<MeshContact> contacts;
     CcdBuffers ccd;                     ///< filled by calculateTimeOfImpact
     std::vector<Vec3> sceneryVertices;  ///< scenery triangles' vertices (world)
+    /// BvhMeshAlgorithm's model of the last call's scenery triangles, with their (part,
+    /// triangle) ids: the next call reuses it when it collects the same triangles, bit for
+    /// bit and in the same order, for the same tree settings (a body resting or sliding on
+    /// scenery keeps its triangles for many steps; building the tree was half of such a
+    /// call).
+    std::shared_ptr<const MeshModel> sceneryModel;
+    std::vector<std::pair<int, int>> sceneryIds;
 };
 
 namespace {
@@ -1589,14 +1596,27 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         SceneryCollector collector(toPose(sceneryWrap->getWorldTransform()));
         scenery->processAllTriangles(&collector, lo, hi);
         if (!collector.triangles.empty()) {
-            std::vector<std::pair<int, int>> ids = std::move(collector.ids);
-            const MeshModel sceneryModel(std::make_shared<const TriangleMesh>(
-                                             "bullet scenery", std::move(collector.vertices),
-                                             std::move(collector.triangles)),
-                                         shape->model().settings());
+            const narrowphase::TreeSettings& tree = shape->model().settings();
+            const MeshModel* cached = state_->sceneryModel.get();
+            if (cached == nullptr || cached->settings().kind != tree.kind ||
+                cached->settings().leaf_size != tree.leaf_size ||
+                state_->sceneryIds != collector.ids ||
+                cached->mesh().triangles() != collector.triangles ||
+                cached->mesh().vertices() != collector.vertices) {
+                state_->sceneryModel = std::make_shared<const MeshModel>(
+                    std::make_shared<const TriangleMesh>("bullet scenery",
+                                                         std::move(collector.vertices),
+                                                         std::move(collector.triangles)),
+                    tree);
+                state_->sceneryIds = std::move(collector.ids);
+                state_->stages.countSceneryModelBuilt();
+            }
+            const MeshModel& sceneryModel = *state_->sceneryModel;
+            const std::vector<std::pair<int, int>>& ids = state_->sceneryIds;
             const Pose meshPose = toPose(meshWrap->getWorldTransform());
             const Pose identity;
-            // A fresh model each call: the traversal front would point into the last one.
+            // No traversal front: a model rebuilt for other triangles would leave it pointing
+            // into the last one.
             QuerySettings settings = contactSettings();
             settings.use_front = false;
             settings.margin = margin;

@@ -296,7 +296,9 @@ std::string describeStages(const MeshStageStats& s) {
     auto n = [](std::uint64_t value) { return std::to_string(value); };
     std::string out;
     out += "queries: " + n(s.mesh_mesh_queries) + " mesh-mesh, " + n(s.mesh_scenery_queries) +
-           " mesh-scenery in " + n(s.pairs) + " pairs; " + n(s.convex_mesh_queries) +
+           " mesh-scenery (" + n(s.scenery_models_built) +
+           " built a model of the scenery's triangles, the others reused their pair's) in " +
+           n(s.pairs) + " pairs; " + n(s.convex_mesh_queries) +
            " convex-mesh (primitive pairs: Bullet's convex-triangle path, no kolize triangle "
            "stage)\n";
     out += std::string("sphere stage (") + stageModeName(set.sphere_stage) +

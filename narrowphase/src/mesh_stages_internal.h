@@ -16,6 +16,7 @@ namespace kolize::detail {
 #define KOLIZE_STAGE_COUNTERS(X) \
     X(mesh_mesh_queries)         \
     X(mesh_scenery_queries)      \
+    X(scenery_models_built)      \
     X(convex_mesh_queries)       \
     X(pairs)                     \
     X(object_sphere_tests)       \
@@ -97,6 +98,9 @@ class PairStages {
     }
     /// Counts a time of impact found below 1.
     void countTimeOfImpactHit() { planner_->add(StagePlanner::k_toi_hits, 1); }
+    /// Counts a model built of scenery triangles (a mesh-scenery query that could not reuse
+    /// its pair's last one).
+    void countSceneryModelBuilt() { planner_->add(StagePlanner::k_scenery_models_built, 1); }
     StagePlanner& planner() { return *planner_; }
 
   private:

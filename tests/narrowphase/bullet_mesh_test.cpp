@@ -1390,6 +1390,77 @@ TEST(BulletMeshContacts, ScaledSceneryIsMeshScenery) {
     }
 }
 
+/// Triangle-mesh scenery of 1 m quads (10 x 10, z = 0) at `floorAt` and a unit box mesh at
+/// `boxAt`.
+struct SceneryAndBox {
+    SceneryAndBox(World& w, const btTransform& floorAt, const btTransform& boxAt) {
+        for (int j = -5; j < 5; ++j) {
+            for (int i = -5; i < 5; ++i) {
+                const btVector3 a(i, j, 0), b(i + 1, j, 0), c(i + 1, j + 1, 0), d(i, j + 1, 0);
+                triangles.addTriangle(a, b, c);
+                triangles.addTriangle(a, c, d);
+            }
+        }
+        floor = w.add(std::make_shared<btBvhTriangleMeshShape>(&triangles, true), floorAt, 0);
+        box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), boxAt, 1);
+    }
+    btTriangleMesh triangles;
+    btRigidBody* floor;
+    btRigidBody* box;
+};
+
+/// A mesh-scenery pair keeps the model (and tree) of the scenery triangles in the mesh's box
+/// while they stay the same, bit for bit: a box sliding 1 cm deep across the quads, then the
+/// floor raised by 1 mm. Every step's contacts equal those of a fresh pair at the same poses
+/// (a new world, whose algorithm builds its model), so a model reused for other triangles or
+/// other vertices would show; and the pair built fewer models than it ran queries.
+TEST(BulletMeshContacts, SceneryTrianglesAreModelledOnceWhileTheyStayTheSame) {
+    World w;
+    btTransform floorAt = at(0, 0, 0);
+    auto boxAt = [](int step) { return at(-2 + 0.05 * step, 0.3, 0.49, 0.3); };
+    SceneryAndBox scene(w, floorAt, boxAt(0));
+    const int steps = 81;
+    int compared = 0;
+    for (int step = 0; step < steps; ++step) {
+        SCOPED_TRACE("step " + std::to_string(step));
+        if (step == 60) {  // the same triangles under the box, 1 mm higher
+            floorAt = at(0, 0, 0.001);
+            scene.floor->setWorldTransform(floorAt);
+        }
+        scene.box->setWorldTransform(boxAt(step));
+        w.world.performDiscreteCollisionDetection();
+        auto* algorithm =
+            dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(scene.floor, scene.box));
+        ASSERT_NE(algorithm, nullptr);
+        World fresh;
+        const SceneryAndBox again(fresh, floorAt, boxAt(step));
+        fresh.world.performDiscreteCollisionDetection();
+        EXPECT_EQ(kolize::narrowphaseStages(&fresh.dispatcher).scenery_models_built, 1u);
+        auto* reference =
+            dynamic_cast<kolize::BvhMeshAlgorithm*>(fresh.algorithm(again.floor, again.box));
+        ASSERT_NE(reference, nullptr);
+        const std::vector<kolize::MeshContact>& got = algorithm->lastContacts();
+        const std::vector<kolize::MeshContact>& want = reference->lastContacts();
+        ASSERT_EQ(got.size(), want.size());
+        for (std::size_t i = 0; i < got.size(); ++i) {
+            EXPECT_EQ(got[i].point, want[i].point) << "contact " << i;
+            EXPECT_EQ(got[i].normal, want[i].normal) << "contact " << i;
+            EXPECT_EQ(got[i].depth, want[i].depth) << "contact " << i;
+            EXPECT_EQ(got[i].triangleX, want[i].triangleX) << "contact " << i;
+            EXPECT_EQ(got[i].partY, want[i].partY) << "contact " << i;
+            EXPECT_EQ(got[i].triangleY, want[i].triangleY) << "contact " << i;
+        }
+        compared += got.empty() ? 0 : 1;
+    }
+    EXPECT_EQ(compared, steps);  // the box touched the floor at every step
+    const kolize::MeshStageStats stats = kolize::narrowphaseStages(&w.dispatcher);
+    EXPECT_EQ(stats.mesh_scenery_queries, std::uint64_t(steps));
+    // Rebuilt as the box's box crossed the quads' edges (4 m over edges 1 m apart) and when
+    // the floor moved; reused in between.
+    EXPECT_GE(stats.scenery_models_built, 6u);
+    EXPECT_LE(stats.scenery_models_built, std::uint64_t(steps / 4));
+}
+
 /// Every body's transform and velocity after `steps` steps of a scene, as raw bytes.
 template <class Scene>
 std::vector<unsigned char> runScene(int steps) {

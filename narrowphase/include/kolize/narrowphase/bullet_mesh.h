@@ -323,9 +323,12 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 
 /// A MeshShape against Bullet's triangle-mesh scenery (btBvhTriangleMeshShape, any order):
 /// the scenery's own tree gives its triangles in the mesh's box; they become a small
-/// narrowphase mesh in world coordinates (vertices welded where exactly equal, rebuilt each
-/// call: O(k log k) for k triangles), queried exactly against the mesh. Contacts as for two
-/// meshes, the scenery's part and triangle index on each point.
+/// narrowphase mesh in world coordinates (vertices welded where exactly equal), queried
+/// exactly against the mesh. Its model (tree) is built, O(k log k) for k triangles, only
+/// when a call collects other triangles than the pair's last call did (compared bit for bit,
+/// O(k)); a body resting or sliding on scenery reuses it for many steps
+/// (MeshStageStats::scenery_models_built). Contacts as for two meshes, the scenery's part and
+/// triangle index on each point.
 /// Time of impact (MeshContactAlgorithm): the mesh against the scenery's triangles in the
 /// box around the mesh at the start and at the end of the step (scenery frame); the scenery
 /// stays at its world transform (Bullet's triangle-mesh scenery is static).

@@ -107,6 +107,10 @@ struct MeshStageStats {
 
     std::uint64_t mesh_mesh_queries = 0;     ///< MeshShape against MeshShape
     std::uint64_t mesh_scenery_queries = 0;  ///< MeshShape against btBvhTriangleMeshShape
+    /// Mesh-scenery queries that built a model (and its tree) of the scenery's triangles in
+    /// the mesh's box; the others reused their pair's last model: the same triangles, bit for
+    /// bit.
+    std::uint64_t scenery_models_built = 0;
     /// Convex shape against MeshShape: Bullet's convex-triangle path, no kolize triangle
     /// stage (processCollision calls).
     std::uint64_t convex_mesh_queries = 0;
