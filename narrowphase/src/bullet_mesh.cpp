@@ -1610,15 +1610,13 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
                     tree);
                 state_->sceneryIds = std::move(collector.ids);
                 state_->stages.countSceneryModelBuilt();
+                state_->query.resetFront();  // it held node pairs of the last model's tree
             }
             const MeshModel& sceneryModel = *state_->sceneryModel;
             const std::vector<std::pair<int, int>>& ids = state_->sceneryIds;
             const Pose meshPose = toPose(meshWrap->getWorldTransform());
             const Pose identity;
-            // No traversal front: a model rebuilt for other triangles would leave it pointing
-            // into the last one.
             QuerySettings settings = contactSettings();
-            settings.use_front = false;
             settings.margin = margin;
             settings = state_->stages.plan(settings, shape->model().mesh().triangleCount(),
                                            sceneryModel.mesh().triangleCount());
