@@ -1070,6 +1070,7 @@ struct MeshContactAlgorithm::State {
     /// call).
     std::shared_ptr<const MeshModel> sceneryModel;
     std::vector<std::pair<int, int>> sceneryIds;
+    std::vector<Vec3> sceneryCorners;  ///< their corners (world), three per triangle
 };
 
 namespace {
@@ -1540,31 +1541,42 @@ btCollisionAlgorithm* ConvexMeshAlgorithm::SwappedCreateFunc::CreateCollisionAlg
 
 namespace {
 
-/// Collects scenery triangles in world coordinates, vertices welded where exactly equal.
+/// Collects scenery triangles in world coordinates: their corners, three per triangle, and
+/// their (part, triangle) ids; weld() makes a mesh of them.
 class SceneryCollector : public btTriangleCallback {
   public:
-    SceneryCollector(const Pose& scenery) : pose_(scenery) {}
+    explicit SceneryCollector(const Pose& scenery) : pose_(scenery) {}
     void processTriangle(btVector3* triangle, int partId, int triangleIndex) override {
-        Index3 t;
         for (int k = 0; k < 3; ++k) {
-            const Vec3 world = pose_.rotation * toVec3(triangle[k]) + pose_.translation;
-            const std::array<double, 3> key{world.x(), world.y(), world.z()};
-            auto [it, inserted] = index_.emplace(key, std::int32_t(vertices.size()));
-            if (inserted) {
-                vertices.push_back(world);
-            }
-            t[k] = it->second;
+            corners.push_back(pose_.rotation * toVec3(triangle[k]) + pose_.translation);
         }
-        triangles.push_back(t);
         ids.emplace_back(partId, triangleIndex);
     }
-    std::vector<Vec3> vertices;
-    std::vector<Index3> triangles;
+    /// The corners as a mesh: vertices welded where exactly equal, in the order of their
+    /// first use, and the triangles indexing them.
+    void weld(std::vector<Vec3>& vertices, std::vector<Index3>& triangles) const {
+        std::map<std::array<double, 3>, std::int32_t> index;
+        vertices.clear();
+        triangles.clear();
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+            Index3 t;
+            for (int k = 0; k < 3; ++k) {
+                const Vec3& corner = corners[3 * i + std::size_t(k)];
+                const std::array<double, 3> key{corner.x(), corner.y(), corner.z()};
+                auto [it, inserted] = index.emplace(key, std::int32_t(vertices.size()));
+                if (inserted) {
+                    vertices.push_back(corner);
+                }
+                t[k] = it->second;
+            }
+            triangles.push_back(t);
+        }
+    }
+    std::vector<Vec3> corners;
     std::vector<std::pair<int, int>> ids;
 
   private:
     Pose pose_;
-    std::map<std::array<double, 3>, std::int32_t> index_;
 };
 
 }  // namespace
@@ -1595,20 +1607,22 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         hi += btVector3(1, 1, 1) * btScalar(margin);
         SceneryCollector collector(toPose(sceneryWrap->getWorldTransform()));
         scenery->processAllTriangles(&collector, lo, hi);
-        if (!collector.triangles.empty()) {
+        if (!collector.ids.empty()) {
             const narrowphase::TreeSettings& tree = shape->model().settings();
             const MeshModel* cached = state_->sceneryModel.get();
             if (cached == nullptr || cached->settings().kind != tree.kind ||
                 cached->settings().leaf_size != tree.leaf_size ||
                 state_->sceneryIds != collector.ids ||
-                cached->mesh().triangles() != collector.triangles ||
-                cached->mesh().vertices() != collector.vertices) {
+                state_->sceneryCorners != collector.corners) {
+                std::vector<Vec3> vertices;
+                std::vector<Index3> triangles;
+                collector.weld(vertices, triangles);
                 state_->sceneryModel = std::make_shared<const MeshModel>(
-                    std::make_shared<const TriangleMesh>("bullet scenery",
-                                                         std::move(collector.vertices),
-                                                         std::move(collector.triangles)),
+                    std::make_shared<const TriangleMesh>("bullet scenery", std::move(vertices),
+                                                         std::move(triangles)),
                     tree);
                 state_->sceneryIds = std::move(collector.ids);
+                state_->sceneryCorners = std::move(collector.corners);
                 state_->stages.countSceneryModelBuilt();
                 state_->query.resetFront();  // it held node pairs of the last model's tree
             }
@@ -1667,20 +1681,21 @@ btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCol
     sweptBoxIn(*shape, *meshObject, sceneryPose, lo, hi);
     SceneryCollector collector(toPose(sceneryPose));
     scenery->processAllTriangles(&collector, lo, hi);
-    if (collector.triangles.empty()) {
+    if (collector.ids.empty()) {
         return btScalar(1);
     }
+    std::vector<Index3> triangles;
+    collector.weld(state_->sceneryVertices, triangles);
     const TriangleMesh& mesh = shape->model().mesh();
     if (!stepOf(*meshObject, mesh.vertices(), state_->ccd.stepA)) {
         return btScalar(1);
     }
     setTriangles(mesh.triangles(), state_->ccd.movingA);
     // The scenery's triangles are already in the world, where they stay.
-    state_->sceneryVertices = std::move(collector.vertices);
     state_->ccd.stepB.vertices = &state_->sceneryVertices;
     state_->ccd.stepB.start = Pose();
     state_->ccd.stepB.end = Pose();
-    setTriangles(collector.triangles, state_->ccd.movingB);
+    setTriangles(triangles, state_->ccd.movingB);
     return reportTimeOfImpact(body0, body1);
 }
 
