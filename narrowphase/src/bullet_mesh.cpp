@@ -4,6 +4,7 @@
 
 #include "convex_ccd.h"
 #include <BulletCollision/CollisionShapes/btConvexShape.h>
+#include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
 #include "mesh_stages_internal.h"
 
 #include <BulletCollision/CollisionDispatch/btCollisionConfiguration.h>
@@ -275,9 +276,9 @@ bool movesOutThrough(const Vec3& d, const Vec3& m) {
 }
 
 /// How far `v` lies inside a mesh below its triangle (q0, q1, q2) with outward unit normal
-/// `m`, measured along -d (d unit, the direction the mesh moves out; movesOutThrough(d, m)):
-/// t >= 0 with v - t d in the closed triangle and v behind or on its plane; -1 when v is in
-/// front or the line passes beside the triangle.
+/// `m` (either winding), measured along -d (d unit, the direction the mesh moves out;
+/// movesOutThrough(d, m)): t >= 0 with v - t d in the closed triangle and v behind or on its
+/// plane; -1 when v is in front or the line passes beside the triangle.
 double depthBelow(const Vec3& v, const Vec3& d, const Vec3& q0, const Vec3& q1, const Vec3& q2,
                   const Vec3& m) {
     const double behind = (v - q0).dot(m);
@@ -288,15 +289,19 @@ double depthBelow(const Vec3& v, const Vec3& d, const Vec3& q0, const Vec3& q1, 
     const double t = behind / along;
     const Vec3 p = v - t * d;
     const Vec3* q[3] = {&q0, &q1, &q2};
+    // p in the closed triangle: on the inner side of its three edges, for either winding
+    // about m (scenery's outward normals are turned towards the body whichever way its
+    // triangles are wound: Bullet's plane and a bowl wound outward are wound against them).
+    // Within a relative hair of an edge counts as on it (the point's rounding).
+    bool innerForWinding = true, innerAgainst = true;
     for (int k = 0; k < 3; ++k) {
         const Vec3 edge = *q[(k + 1) % 3] - *q[k];
-        // Within a relative hair of an edge counts as on it (the point's rounding).
-        if (edge.cross(p - *q[k]).dot(m) <
-            -1e-12 * (edge.squaredNorm() + (p - *q[k]).squaredNorm())) {
-            return -1;
-        }
+        const double side = edge.cross(p - *q[k]).dot(m);
+        const double hair = 1e-12 * (edge.squaredNorm() + (p - *q[k]).squaredNorm());
+        innerForWinding = innerForWinding && side >= -hair;
+        innerAgainst = innerAgainst && side <= hair;
     }
-    return t;
+    return innerForWinding || innerAgainst ? t : -1;
 }
 
 /// Whether the points of candidates[first..] span an area: not all within 1e-9 of their
@@ -1547,8 +1552,13 @@ class SceneryCollector : public btTriangleCallback {
   public:
     explicit SceneryCollector(const Pose& scenery) : pose_(scenery) {}
     void processTriangle(btVector3* triangle, int partId, int triangleIndex) override {
-        for (int k = 0; k < 3; ++k) {
-            corners.push_back(pose_.rotation * toVec3(triangle[k]) + pose_.translation);
+        const Vec3 local[3] = {toVec3(triangle[0]), toVec3(triangle[1]), toVec3(triangle[2])};
+        add(local, partId, triangleIndex);
+    }
+    /// A triangle of corners in the scenery's frame.
+    void add(const Vec3 (&local)[3], int partId, int triangleIndex) {
+        for (const Vec3& corner : local) {
+            corners.push_back(pose_.rotation * corner + pose_.translation);
         }
         ids.emplace_back(partId, triangleIndex);
     }
@@ -1579,6 +1589,47 @@ class SceneryCollector : public btTriangleCallback {
     Pose pose_;
 };
 
+/// The scenery's triangles that may meet the box [lo, hi] (its own frame) into `collector`.
+/// A static plane gives two triangles of a square in it, fixed in the plane's frame: half
+/// side s, the power of two at or above the box's diagonal, centred on the multiple of s
+/// nearest the box's centre along the plane's two tangents. It covers the box's projection
+/// and stays the same while the body moves within it. (Bullet's own processAllTriangles
+/// centres its two triangles on the box, so their diagonal under a resting body moved with
+/// it every step, and the contacts of the body's nearly coplanar face moved with it: a box
+/// resting on a tilted plane was kicked after 3.8 s.)
+void collectScenery(const btConcaveShape& scenery, const btVector3& lo, const btVector3& hi,
+                    SceneryCollector& collector) {
+    if (scenery.getShapeType() != STATIC_PLANE_PROXYTYPE) {
+        scenery.processAllTriangles(&collector, lo, hi);
+        return;
+    }
+    const auto& plane = static_cast<const btStaticPlaneShape&>(scenery);
+    const Vec3 n = toVec3(plane.getPlaneNormal());  // unit as Bullet stores it
+    const double n2 = n.squaredNorm();
+    if (!(n2 > 0)) {
+        return;  // no plane
+    }
+    const Vec3 foot = n * (double(plane.getPlaneConstant()) / n2);  // the plane's point nearest 0
+    const Vec3 centre = 0.5 * (toVec3(lo) + toVec3(hi));
+    const double half = std::exp2(std::ceil(
+        std::log2(std::max((toVec3(hi) - toVec3(lo)).norm(), std::numeric_limits<double>::min()))));
+    if (!std::isfinite(foot.squaredNorm() + centre.squaredNorm() + half)) {
+        return;  // nothing finite to meet
+    }
+    // Unit tangents p, q with p x q along n (btPlaneSpace1's choice, in double).
+    Vec3 p = std::fabs(n.z()) > std::sqrt(0.5) ? Vec3(0, -n.z(), n.y()) : Vec3(-n.y(), n.x(), 0);
+    p.normalize();
+    const Vec3 q = n.cross(p).normalized();
+    const Vec3 middle = foot + std::round((centre - foot).dot(p) / half) * half * p +
+                        std::round((centre - foot).dot(q) / half) * half * q;
+    const Vec3 a = middle - half * p - half * q, b = middle + half * p - half * q;
+    const Vec3 c = middle + half * p + half * q, d = middle - half * p + half * q;
+    const Vec3 first[3] = {a, b, c};  // wound about n
+    const Vec3 second[3] = {a, c, d};
+    collector.add(first, 0, 0);
+    collector.add(second, 0, 1);
+}
+
 }  // namespace
 
 BvhMeshAlgorithm::BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -1606,7 +1657,7 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
         lo -= btVector3(1, 1, 1) * btScalar(margin);
         hi += btVector3(1, 1, 1) * btScalar(margin);
         SceneryCollector collector(toPose(sceneryWrap->getWorldTransform()));
-        scenery->processAllTriangles(&collector, lo, hi);
+        collectScenery(*scenery, lo, hi, collector);
         if (!collector.ids.empty()) {
             const narrowphase::TreeSettings& tree = shape->model().settings();
             const MeshModel* cached = state_->sceneryModel.get();
@@ -1680,7 +1731,7 @@ btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCol
     btVector3 lo, hi;
     sweptBoxIn(*shape, *meshObject, sceneryPose, lo, hi);
     SceneryCollector collector(toPose(sceneryPose));
-    scenery->processAllTriangles(&collector, lo, hi);
+    collectScenery(*scenery, lo, hi, collector);
     if (collector.ids.empty()) {
         return btScalar(1);
     }
@@ -1755,7 +1806,8 @@ void registerNarrowphase(btCollisionDispatcher* dispatcher, const MeshStageSetti
         both(mesh, type, &meshConvex);
     }
     for (int scenery :
-         {int(TRIANGLE_MESH_SHAPE_PROXYTYPE), int(SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE)}) {
+         {int(TRIANGLE_MESH_SHAPE_PROXYTYPE), int(SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE),
+          int(TERRAIN_SHAPE_PROXYTYPE), int(STATIC_PLANE_PROXYTYPE)}) {
         both(mesh, scenery, &meshScenery);
         both(scenery, mesh, &sceneryMesh);
     }

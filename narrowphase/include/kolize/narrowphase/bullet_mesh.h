@@ -321,8 +321,11 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
     std::unique_ptr<Ccd> ccd_;
 };
 
-/// A MeshShape against Bullet's triangle-mesh scenery (btBvhTriangleMeshShape, any order):
-/// the scenery's own tree gives its triangles in the mesh's box; they become a small
+/// A MeshShape against Bullet's static concave scenery, any order: btBvhTriangleMeshShape
+/// (scaled too), btHeightfieldTerrainShape and btStaticPlaneShape (Bullet itself has no
+/// algorithm for two concave shapes: without these a mesh body fell through a static plane
+/// or a heightfield). The scenery's processAllTriangles gives its triangles in the mesh's box
+/// (a plane: two triangles around the box's projection onto it); they become a small
 /// narrowphase mesh in world coordinates (vertices welded where exactly equal), queried
 /// exactly against the mesh. Its model (tree) is built, O(k log k) for k triangles, only
 /// when a call collects other triangles than the pair's last call did (compared bit for bit,
@@ -364,7 +367,8 @@ class BvhMeshAlgorithm : public MeshContactAlgorithm {
 /// Registers the algorithms above on `dispatcher`, in both its contact-point
 /// (registerCollisionCreateFunc) and closest-point (registerClosestPointsCreateFunc) tables:
 /// MeshShape against MeshShape, against every convex shape type in both orders, and against
-/// TRIANGLE_MESH_SHAPE_PROXYTYPE and SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE in both orders.
+/// TRIANGLE_MESH_SHAPE_PROXYTYPE, SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE, TERRAIN_SHAPE_PROXYTYPE
+/// and STATIC_PLANE_PROXYTYPE in both orders (BvhMeshAlgorithm).
 /// Compounds keep Bullet's compound algorithm, which dispatches their children to these
 /// pairs. The create functions are static: they outlive every dispatcher. Throws
 /// std::invalid_argument for a null dispatcher, and for a configuration whose collision
