@@ -325,13 +325,14 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 /// (scaled too), btHeightfieldTerrainShape and btStaticPlaneShape (Bullet itself has no
 /// algorithm for two concave shapes: without these a mesh body fell through a static plane
 /// or a heightfield). The scenery's processAllTriangles gives its triangles in the mesh's box
-/// (a plane: two triangles around the box's projection onto it); they become a small
-/// narrowphase mesh in world coordinates (vertices welded where exactly equal), queried
-/// exactly against the mesh. Its model (tree) is built, O(k log k) for k triangles, only
-/// when a call collects other triangles than the pair's last call did (compared bit for bit,
-/// O(k)); a body resting or sliding on scenery reuses it for many steps
-/// (MeshStageStats::scenery_models_built). Contacts as for two meshes, the scenery's part and
-/// triangle index on each point.
+/// (a plane: two triangles of a square fixed in the plane's frame that covers the box's
+/// projection, not Bullet's two centred on the box, which moved under a resting body); they
+/// become a small narrowphase mesh in world coordinates (vertices welded where exactly
+/// equal), queried exactly against the mesh. Its model (tree) is built, O(k log k) for k
+/// triangles, only when a call collects other triangles than the pair's last call did
+/// (compared bit for bit, O(k)); a body resting or sliding on scenery reuses it for many
+/// steps (MeshStageStats::scenery_models_built). Contacts as for two meshes, the scenery's
+/// part and triangle index on each point.
 /// Time of impact (MeshContactAlgorithm): the mesh against the scenery's triangles in the
 /// box around the mesh at the start and at the end of the step (scenery frame); the scenery
 /// stays at its world transform (Bullet's triangle-mesh scenery is static).
