@@ -679,16 +679,21 @@ TEST(BulletMeshContacts, StackOfBoxMeshesHasTheExactContacts) {
 /// A box mesh on a static, triangulated floor (btBvhTriangleMeshShape, 10 x 10 quads of
 /// 1 m, 200 triangles), centred on a grid vertex and a second one turned across diagonals:
 /// the internal edges must not make ghost contacts (fcl#106's hanging box).
+/// Adds the 10 x 10 quads of 1 m at z = 0 (x, y in -5..5), two triangles each, wound up.
+void addUnitQuads(btTriangleMesh& triangles) {
+    for (int j = -5; j < 5; ++j) {
+        for (int i = -5; i < 5; ++i) {
+            const btVector3 a(i, j, 0), b(i + 1, j, 0), c(i + 1, j + 1, 0), d(i, j + 1, 0);
+            triangles.addTriangle(a, b, c);
+            triangles.addTriangle(a, c, d);
+        }
+    }
+}
+
 struct Floor {
     explicit Floor(World& w) {
         triangles = std::make_unique<btTriangleMesh>();
-        for (int j = -5; j < 5; ++j) {
-            for (int i = -5; i < 5; ++i) {
-                const btVector3 a(i, j, 0), b(i + 1, j, 0), c(i + 1, j + 1, 0), d(i, j + 1, 0);
-                triangles->addTriangle(a, b, c);
-                triangles->addTriangle(a, c, d);
-            }
-        }
+        addUnitQuads(*triangles);
         floor =
             w.add(std::make_shared<btBvhTriangleMeshShape>(triangles.get(), true), at(0, 0, 0), 0);
         boxes[0] = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), at(0, 0, 0.51), 1);
@@ -1404,13 +1409,7 @@ TEST(BulletMeshContacts, ScaledSceneryIsMeshScenery) {
 /// `boxAt`.
 struct SceneryAndBox {
     SceneryAndBox(World& w, const btTransform& floorAt, const btTransform& boxAt) {
-        for (int j = -5; j < 5; ++j) {
-            for (int i = -5; i < 5; ++i) {
-                const btVector3 a(i, j, 0), b(i + 1, j, 0), c(i + 1, j + 1, 0), d(i, j + 1, 0);
-                triangles.addTriangle(a, b, c);
-                triangles.addTriangle(a, c, d);
-            }
-        }
+        addUnitQuads(triangles);
         floor = w.add(std::make_shared<btBvhTriangleMeshShape>(&triangles, true), floorAt, 0);
         box = w.add(boxShape(Vec3(0.5, 0.5, 0.5)), boxAt, 1);
     }
