@@ -1807,7 +1807,8 @@ void registerNarrowphase(btCollisionDispatcher* dispatcher, const MeshStageSetti
     }
     for (int scenery :
          {int(TRIANGLE_MESH_SHAPE_PROXYTYPE), int(SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE),
-          int(TERRAIN_SHAPE_PROXYTYPE), int(STATIC_PLANE_PROXYTYPE)}) {
+          int(MULTIMATERIAL_TRIANGLE_MESH_PROXYTYPE), int(TERRAIN_SHAPE_PROXYTYPE),
+          int(STATIC_PLANE_PROXYTYPE)}) {
         both(mesh, scenery, &meshScenery);
         both(scenery, mesh, &sceneryMesh);
     }

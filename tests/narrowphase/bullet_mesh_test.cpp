@@ -8,6 +8,8 @@
 #include "kolize/narrowphase/mesh_stages.h"
 
 #include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
+#include <BulletCollision/CollisionShapes/btMultimaterialTriangleMeshShape.h>
+#include <BulletCollision/CollisionShapes/btTriangleIndexVertexMaterialArray.h>
 #include <btBulletCollisionCommon.h>
 #include <btBulletDynamicsCommon.h>
 
@@ -312,12 +314,13 @@ TEST(BulletMeshRegistration, BothTablesHoldEveryPair) {
     }
     pairs.emplace_back(mesh, TRIANGLE_MESH_SHAPE_PROXYTYPE);
     pairs.emplace_back(TRIANGLE_MESH_SHAPE_PROXYTYPE, mesh);
-    for (int scenery : {int(SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE), int(TERRAIN_SHAPE_PROXYTYPE),
-                        int(STATIC_PLANE_PROXYTYPE)}) {
+    for (int scenery :
+         {int(SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE), int(MULTIMATERIAL_TRIANGLE_MESH_PROXYTYPE),
+          int(TERRAIN_SHAPE_PROXYTYPE), int(STATIC_PLANE_PROXYTYPE)}) {
         pairs.emplace_back(mesh, scenery);
         pairs.emplace_back(scenery, mesh);
     }
-    EXPECT_EQ(pairs.size(), 1u + 2 * 19 + 8);  // 19 convex types in Bullet 3.24
+    EXPECT_EQ(pairs.size(), 1u + 2 * 19 + 10);  // 19 convex types in Bullet 3.24
     for (auto [a, b] : pairs) {
         EXPECT_NE(registered.contactFunc(a, b), plain.contactFunc(a, b)) << a << ' ' << b;
         EXPECT_NE(registered.closestFunc(a, b), plain.closestFunc(a, b)) << a << ' ' << b;
@@ -1594,6 +1597,79 @@ TEST(BulletMeshContacts, MeshesRestOnStaticPlanesAndHeightfields) {
             // this box 0.11 m/s and 0.22 rad/s after 3.8 s).
             EXPECT_LT(lateSpeed, 0.05);
         }
+    }
+}
+
+TEST(BulletMeshContacts, MultimaterialSceneryNamesEachContactsTriangleAndMaterial) {
+    // Two 2 m x 2 m quads at z = 0, x < 0 of material 0 and x > 0 of material 1, wound up.
+    btScalar vertices[] = {-2, -1, 0, 0, -1, 0, 0, 1, 0, -2, 1, 0, 2, -1, 0, 2, 1, 0};
+    int indices[] = {0, 1, 2, 0, 2, 3, 1, 4, 5, 1, 5, 2};
+    btMaterial materials[] = {btMaterial(btScalar(0.1), btScalar(0)),
+                              btMaterial(btScalar(0.9), btScalar(0.5))};
+    int materialOf[] = {0, 0, 1, 1};
+    btTriangleIndexVertexMaterialArray data(4, indices, 3 * int(sizeof(int)), 6, vertices,
+                                            3 * int(sizeof(btScalar)), 2,
+                                            reinterpret_cast<unsigned char*>(materials),
+                                            int(sizeof(btMaterial)), materialOf, int(sizeof(int)));
+    auto multimaterial = [&] {
+        return std::make_shared<btMultimaterialTriangleMeshShape>(&data, true);
+    };
+    {  // The control: unregistered, Bullet has no algorithm and the mesh body falls through.
+        World plain(false);
+        plain.add(multimaterial(), at(0, 0, 0), 0);
+        btRigidBody* box = plain.add(boxShape(Vec3::Constant(0.5)), at(-1, 0, 0.6), 1);
+        for (int step = 0; step < 120; ++step) {
+            plain.world.stepSimulation(btScalar(1.0 / 60), 0);
+        }
+        EXPECT_LT(box->getWorldTransform().getOrigin().z(), -1);
+    }
+    // A box 1 cm deep over the left quad, over the right one, and across both.
+    for (double x : {-1.0, 1.0, 0.0}) {
+        SCOPED_TRACE(x);
+        World w;
+        auto shape = multimaterial();
+        btRigidBody* floor = w.add(shape, at(0, 0, 0), 0);
+        btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), at(x, 0, 0.49, 0.3), 1);
+        w.world.performDiscreteCollisionDetection();
+        auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(floor, box));
+        ASSERT_NE(algorithm, nullptr);
+        const std::vector<kolize::MeshContact>& contacts = algorithm->lastContacts();
+        EXPECT_GE(contacts.size(), 3u);
+        std::set<int> seen;
+        for (const kolize::MeshContact& c : contacts) {
+            EXPECT_LT((c.normal - Vec3(0, 0, -1)).norm(), 1e-5);  // X = the mesh, into the floor
+            EXPECT_NEAR(c.depth, 0.01, 1e-5);
+            // The floor's triangle holds the point's foot, and its material is the side's.
+            ASSERT_GE(c.triangleY, 0);
+            ASSERT_LT(c.triangleY, 4);
+            EXPECT_EQ(c.partY, 0);
+            EXPECT_EQ(materialOf[c.triangleY], c.point.x() < 0 ? 0 : 1) << c.point.x();
+            seen.insert(materialOf[c.triangleY]);
+        }
+        EXPECT_EQ(seen.size(), x == 0.0 ? 2u : 1u);
+        // What a contact callback gets: the manifold point's ids on the floor's side name the
+        // material of the floor under the point.
+        const btPersistentManifold* manifold = onlyManifold(algorithm);
+        ASSERT_NE(manifold, nullptr);
+        ASSERT_GE(manifold->getNumContacts(), 3);
+        for (int k = 0; k < manifold->getNumContacts(); ++k) {
+            const btManifoldPoint& p = manifold->getContactPoint(k);
+            const bool floorFirst = manifold->getBody0() == floor;
+            const btMaterial* material = shape->getMaterialProperties(
+                floorFirst ? p.m_partId0 : p.m_partId1, floorFirst ? p.m_index0 : p.m_index1);
+            const double pointX = 0.5 * (p.getPositionWorldOnA().x() + p.getPositionWorldOnB().x());
+            EXPECT_EQ(material->m_friction, pointX < 0 ? btScalar(0.1) : btScalar(0.9)) << pointX;
+        }
+    }
+    {  // At rest on it: face down on the floor, as on a btBvhTriangleMeshShape.
+        World w;
+        w.add(multimaterial(), at(0, 0, 0), 0);
+        btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), at(0.3, 0.2, 0.7, 0.5), 1);
+        for (int step = 0; step < 180; ++step) {
+            w.world.stepSimulation(btScalar(1.0 / 60), 0);
+        }
+        EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 0.5, 0.01);
+        EXPECT_LT(box->getLinearVelocity().length(), 0.05);
     }
 }
 

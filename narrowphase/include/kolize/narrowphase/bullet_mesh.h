@@ -322,7 +322,9 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 };
 
 /// A MeshShape against Bullet's static concave scenery, any order: btBvhTriangleMeshShape
-/// (scaled too), btHeightfieldTerrainShape and btStaticPlaneShape (Bullet itself has no
+/// (scaled too, and btMultimaterialTriangleMeshShape: each contact carries the scenery
+/// triangle's part and index, which its getMaterialProperties takes),
+/// btHeightfieldTerrainShape and btStaticPlaneShape (Bullet itself has no
 /// algorithm for two concave shapes: without these a mesh body fell through a static plane
 /// or a heightfield). The scenery's processAllTriangles gives its triangles in the mesh's box
 /// (a plane: two triangles of a square fixed in the plane's frame that covers the box's
@@ -368,8 +370,9 @@ class BvhMeshAlgorithm : public MeshContactAlgorithm {
 /// Registers the algorithms above on `dispatcher`, in both its contact-point
 /// (registerCollisionCreateFunc) and closest-point (registerClosestPointsCreateFunc) tables:
 /// MeshShape against MeshShape, against every convex shape type in both orders, and against
-/// TRIANGLE_MESH_SHAPE_PROXYTYPE, SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE, TERRAIN_SHAPE_PROXYTYPE
-/// and STATIC_PLANE_PROXYTYPE in both orders (BvhMeshAlgorithm).
+/// TRIANGLE_MESH_SHAPE_PROXYTYPE, SCALED_TRIANGLE_MESH_SHAPE_PROXYTYPE,
+/// MULTIMATERIAL_TRIANGLE_MESH_PROXYTYPE, TERRAIN_SHAPE_PROXYTYPE and STATIC_PLANE_PROXYTYPE in
+/// both orders (BvhMeshAlgorithm).
 /// Compounds keep Bullet's compound algorithm, which dispatches their children to these
 /// pairs. The create functions are static: they outlive every dispatcher. Throws
 /// std::invalid_argument for a null dispatcher, and for a configuration whose collision
