@@ -1555,11 +1555,19 @@ class SceneryCollector : public btTriangleCallback {
         const Vec3 local[3] = {toVec3(triangle[0]), toVec3(triangle[1]), toVec3(triangle[2])};
         add(local, partId, triangleIndex);
     }
-    /// A triangle of corners in the scenery's frame.
+    /// A triangle of corners in the scenery's frame. One with a corner that is not finite
+    /// there or in the world (a heightfield's NaN height) is left out, as Bullet's own
+    /// algorithms leave it: it meets nothing, and a mesh of it would be refused (MeshError,
+    /// which would unwind through Bullet's step).
     void add(const Vec3 (&local)[3], int partId, int triangleIndex) {
-        for (const Vec3& corner : local) {
-            corners.push_back(pose_.rotation * corner + pose_.translation);
+        Vec3 world[3];
+        for (int k = 0; k < 3; ++k) {
+            world[k] = pose_.rotation * local[k] + pose_.translation;
+            if (!world[k].allFinite()) {
+                return;
+            }
         }
+        corners.insert(corners.end(), world, world + 3);
         ids.emplace_back(partId, triangleIndex);
     }
     /// The corners as a mesh: vertices welded where exactly equal, in the order of their

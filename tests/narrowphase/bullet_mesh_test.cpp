@@ -1673,6 +1673,40 @@ TEST(BulletMeshContacts, MultimaterialSceneryNamesEachContactsTriangleAndMateria
     }
 }
 
+TEST(BulletMeshContacts, NonFiniteSceneryTrianglesAreLeftOut) {
+    // A heightfield of 4 x 4 samples (3 x 3 quads of 1 m about the origin), flat at 0, with
+    // NaN heights: every one, or the corner sample at (-1.5, -1.5) only. A triangle with a
+    // NaN corner made the scenery mesh refuse it (MeshError out of stepSimulation).
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (bool allNan : {true, false}) {
+        SCOPED_TRACE(allNan ? "every height NaN" : "one corner NaN");
+        std::vector<float> heights(16, 0.0f);
+        if (allNan) {
+            std::fill(heights.begin(), heights.end(), nan);
+        } else {
+            heights[0] = nan;
+        }
+        World w;
+        w.add(
+            std::make_shared<btHeightfieldTerrainShape>(
+                4, 4, heights.data(), btScalar(1), btScalar(-1), btScalar(1), 2, PHY_FLOAT, false),
+            at(0, 0, 0), 0);
+        // Over the far corner's quad, and one across the quads around the NaN sample.
+        btRigidBody* far = w.add(boxShape(Vec3::Constant(0.3)), at(0.8, 0.8, 0.35), 1);
+        btRigidBody* near = w.add(boxShape(Vec3::Constant(0.3)), at(-1.3, -1.3, 0.35), 1);
+        for (int step = 0; step < 120; ++step) {
+            ASSERT_NO_THROW(w.world.stepSimulation(btScalar(1.0 / 60), 0)) << step;
+        }
+        const double z = far->getWorldTransform().getOrigin().z();
+        if (allNan) {
+            EXPECT_LT(z, -1);  // nothing left to meet, as for Bullet's own shapes
+        } else {
+            EXPECT_NEAR(z, 0.3, 0.01);  // the finite triangles still hold it
+        }
+        EXPECT_TRUE(std::isfinite(double(near->getWorldTransform().getOrigin().z())));
+    }
+}
+
 /// Every body's transform and velocity after `steps` steps of a scene, as raw bytes.
 template <class Scene>
 std::vector<unsigned char> runScene(int steps) {
