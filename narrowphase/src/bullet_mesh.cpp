@@ -1598,13 +1598,13 @@ class SceneryCollector : public btTriangleCallback {
 };
 
 /// The scenery's triangles that may meet the box [lo, hi] (its own frame) into `collector`.
-/// A static plane gives two triangles of a square in it, fixed in the plane's frame: half
+/// A static plane (for the time of impact only: its contacts are a half-space's, see
+/// planeContacts) gives two triangles of a square in it, fixed in the plane's frame: half
 /// side s, the power of two at or above the box's diagonal, centred on the multiple of s
 /// nearest the box's centre along the plane's two tangents. It covers the box's projection
 /// and stays the same while the body moves within it. (Bullet's own processAllTriangles
 /// centres its two triangles on the box, so their diagonal under a resting body moved with
-/// it every step, and the contacts of the body's nearly coplanar face moved with it: a box
-/// resting on a tilted plane was kicked after 3.8 s.)
+/// it every step.)
 void collectScenery(const btConcaveShape& scenery, const btVector3& lo, const btVector3& hi,
                     SceneryCollector& collector) {
     if (scenery.getShapeType() != STATIC_PLANE_PROXYTYPE) {
@@ -1638,6 +1638,81 @@ void collectScenery(const btConcaveShape& scenery, const btVector3& lo, const bt
     collector.add(second, 0, 1);
 }
 
+/// A static plane is a half-space, as Bullet's own algorithms take it for convex shapes:
+/// every vertex of the mesh on or below the plane is in it, whatever the body's side (its
+/// two triangles as two-sided scenery pushed a body whose centre had sunk below the plane
+/// further down, and one wholly below met nothing). The candidates are those vertices (or,
+/// when none is, the ones within `margin` above), each at its own depth below the plane,
+/// normal -n (from the mesh into the plane), the point halfway to the vertex's foot on the
+/// plane; up to 4 chosen as for two meshes. In the mesh's frame (X = the mesh; the plane
+/// has no triangle: Y's ids -1). Returns whether a vertex is in the half-space.
+bool planeContacts(const btStaticPlaneShape& plane, const Pose& planePose, const MeshShape& shape,
+                   const Pose& meshPose, double margin, double separation, ContactScratch& s,
+                   std::vector<MeshContact>& out) {
+    const Vec3 given = toVec3(plane.getPlaneNormal());
+    const double length = given.norm();
+    if (!(length > 0) || !std::isfinite(length) ||
+        !std::isfinite(double(plane.getPlaneConstant()))) {
+        return false;  // no plane
+    }
+    // The plane n . x = c in the world, then in the mesh's frame.
+    const Vec3 worldNormal = planePose.rotation * (given / length);
+    const double worldConstant =
+        double(plane.getPlaneConstant()) / length + worldNormal.dot(planePose.translation);
+    const Vec3 n = meshPose.rotation.transpose() * worldNormal;
+    const double c = worldConstant - worldNormal.dot(meshPose.translation);
+    const narrowphase::MeshModel& model = shape.model();
+    if (n.dot(model.sphere().center) - c - model.sphere().radius > margin) {
+        return false;  // every vertex above the plane by more than the margin
+    }
+    const std::vector<Vec3>& vertices = model.mesh().vertices();
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Vec3& v : vertices) {
+        lowest = std::min(lowest, n.dot(v) - c);
+    }
+    if (!(lowest <= margin)) {
+        return false;
+    }
+    const bool inside = lowest <= 0;
+    const double reach = inside ? 0.0 : margin;
+    if (s.insideOfA.size() < vertices.size()) {
+        s.insideOfA.resize(vertices.size(), -1);
+    }
+    s.candidates.clear();
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const double height = n.dot(vertices[i]) - c;
+        if (height <= reach) {
+            s.insideOfA[i] = int(s.candidates.size());
+            s.candidates.push_back(
+                {vertices[i] - (0.5 * height) * n, 0, TrianglePair{-1, -1}, -height});
+        }
+    }
+    // Each point's triangle: the first of the mesh's triangles at its vertex.
+    const std::vector<Index3>& triangles = model.mesh().triangles();
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+            const int at = s.insideOfA[triangles[t][k]];
+            if (at >= 0 && s.candidates[at].ids.a < 0) {
+                s.candidates[at].ids.a = std::int32_t(t);
+            }
+        }
+    }
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        s.insideOfA[i] = -1;
+    }
+    Patch patch;
+    patch.normal = -n;
+    patch.depth = -lowest;
+    patch.valid = true;
+    s.patches.assign(1, patch);
+    chooseContacts(s, separation, out);
+    for (MeshContact& contact : out) {
+        contact.partY = -1;
+        contact.triangleY = -1;
+    }
+    return inside;
+}
+
 }  // namespace
 
 BvhMeshAlgorithm::BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
@@ -1655,7 +1730,22 @@ void BvhMeshAlgorithm::processCollision(const btCollisionObjectWrapper* body0,
     const auto* shape = static_cast<const MeshShape*>(meshWrap->getCollisionShape());
     const auto* scenery = static_cast<const btConcaveShape*>(sceneryWrap->getCollisionShape());
     bool touching = false;
-    if (finitePose(meshWrap->getWorldTransform()) && finitePose(sceneryWrap->getWorldTransform())) {
+    if (scenery->getShapeType() == STATIC_PLANE_PROXYTYPE &&
+        finitePose(meshWrap->getWorldTransform()) && finitePose(sceneryWrap->getWorldTransform())) {
+        const Pose meshPose = toPose(meshWrap->getWorldTransform());
+        const double margin = contactMargin(state_->stages, manifold_, resultOut);
+        touching = planeContacts(static_cast<const btStaticPlaneShape&>(*scenery),
+                                 toPose(sceneryWrap->getWorldTransform()), *shape, meshPose, margin,
+                                 breakingThreshold(manifold_), contactScratch, state_->contacts);
+        if (!state_->contacts.empty()) {
+            toWorld(state_->contacts, meshPose);
+            dropStalePoints(ownManifold_, resultOut);
+            emit(state_->contacts, meshFirst_, resultOut);
+        }
+        state_->stages.report(detail::PairKind::kMeshScenery, narrowphase::QueryCounters{},
+                              state_->contacts.size());
+    } else if (finitePose(meshWrap->getWorldTransform()) &&
+               finitePose(sceneryWrap->getWorldTransform())) {
         // The mesh's box in the scenery's frame, and the scenery's triangles in it.
         const btTransform meshInScenery =
             sceneryWrap->getWorldTransform().inverse() * meshWrap->getWorldTransform();

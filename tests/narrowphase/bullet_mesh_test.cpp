@@ -1600,6 +1600,116 @@ TEST(BulletMeshContacts, MeshesRestOnStaticPlanesAndHeightfields) {
     }
 }
 
+/// A btStaticPlaneShape is a half-space, as Bullet takes it for its convex shapes: a mesh
+/// body's vertices on or below it are in it, whatever side its centre is on. As two-sided
+/// scenery triangles, a box whose centre had sunk 1 cm below the plane got normals that
+/// pushed it down (it fell 5.5 m in 1 s), one wholly below met nothing, and a box dropped at
+/// 100 m/s went through; a box at rest on a plane was kicked to 0.04 m/s (0.003 on the same
+/// floor as two triangles). The reference for the dynamics is Bullet's own btBoxShape.
+TEST(BulletMeshContacts, AStaticPlaneIsAHalfSpace) {
+    const Vec3 up(0, 0, 1);
+    auto plane = [] { return std::make_shared<btStaticPlaneShape>(btVector3(0, 0, 1), 0); };
+    auto tiltedAt = [](double z) {
+        btTransform t = at(0.3, -0.2, z);
+        t.setRotation(btQuaternion(btVector3(1, 0.5, 0).normalized(), btScalar(0.2)));
+        return t;
+    };
+    for (double z : {0.4, -0.01, -0.2, -0.6}) {  // -0.6: wholly below
+        SCOPED_TRACE(z);
+        World w;
+        btRigidBody* ground = w.add(plane(), at(0, 0, 0), 0);
+        const btTransform pose = tiltedAt(z);
+        btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), pose, 1);
+        w.world.performDiscreteCollisionDetection();
+        auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(ground, box));
+        ASSERT_NE(algorithm, nullptr);
+        const std::vector<double> corners = cornerHeights(pose, up, 0);
+        const auto below = std::size_t(
+            std::count_if(corners.begin(), corners.end(), [](double h) { return h <= 0; }));
+        const std::vector<kolize::MeshContact>& contacts = algorithm->lastContacts();
+        ASSERT_EQ(contacts.size(), std::min<std::size_t>(below, 4));
+        EXPECT_NEAR(contacts.front().depth, -corners.front(), 1e-5);  // the deepest first
+        for (const kolize::MeshContact& c : contacts) {
+            EXPECT_LT((c.normal + up).norm(), 1e-6);  // from the mesh into the plane
+            // The depth of a corner below the plane, the point halfway to its foot.
+            const double corner =
+                *std::min_element(corners.begin(), corners.end(), [&](double x, double y) {
+                    return std::fabs(x + c.depth) < std::fabs(y + c.depth);
+                });
+            EXPECT_LT(std::fabs(corner + c.depth), 1e-5);
+            EXPECT_NEAR(c.point.z(), -0.5 * c.depth, 1e-5);
+            EXPECT_EQ(c.triangleY, -1);  // the plane has no triangles
+            EXPECT_GE(c.triangleX, 0);
+        }
+    }
+    // Pushed out as Bullet pushes its own box out, from 1 cm, 20 cm and wholly below.
+    for (double z : {-0.01, -0.2, -0.6}) {
+        SCOPED_TRACE(z);
+        for (bool mesh : {true, false}) {
+            World w;
+            w.add(plane(), at(0, 0, 0), 0);
+            std::shared_ptr<btCollisionShape> shape = boxShape(Vec3::Constant(0.5));
+            if (!mesh) {
+                shape = std::make_shared<btBoxShape>(btVector3(0.5, 0.5, 0.5));
+            }
+            btRigidBody* box = w.add(shape, tiltedAt(z), 1);
+            for (int step = 0; step < 120; ++step) {
+                w.world.stepSimulation(btScalar(1.0 / 60), 0);
+            }
+            EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 0.5, 0.02) << mesh;
+        }
+    }
+    {  // Dropped at 200 m/s without CCD (3.3 m per step: wholly below after the first step),
+       // it is pushed back out and comes to rest on the plane. (Bullet's own btBoxShape from
+       // the same pose and speed ends 7.6 m up after 3 s.)
+        World w;
+        w.add(plane(), at(0, 0, 0), 0);
+        btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), tiltedAt(1), 1);
+        box->setLinearVelocity(btVector3(0, 0, -200));
+        for (int step = 0; step < 180; ++step) {
+            w.world.stepSimulation(btScalar(1.0 / 60), 0);
+        }
+        EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 0.5, 0.01);
+        EXPECT_LT(box->getLinearVelocity().length(), 0.05);
+    }
+    {  // At rest for 20 s after settling for 2 s: no kick.
+        World w;
+        w.add(plane(), at(0, 0, 0), 0);
+        btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), at(0.3, 0.2, 0.5005, 0.4), 1);
+        for (int step = 0; step < 120; ++step) {
+            w.world.stepSimulation(btScalar(1.0 / 60), 0);
+        }
+        const btVector3 settled = box->getWorldTransform().getOrigin();
+        double fastest = 0;
+        for (int step = 0; step < 1200; ++step) {
+            w.world.stepSimulation(btScalar(1.0 / 60), 0);
+            fastest = std::max({fastest, double(box->getLinearVelocity().length()),
+                                double(box->getAngularVelocity().length())});
+        }
+        EXPECT_LT(fastest, 1e-3);
+        EXPECT_LT((box->getWorldTransform().getOrigin() - settled).length(), 1e-4);
+    }
+    {  // A contact margin: a box 2 mm above gets separated contacts, one 1 cm above none.
+        for (double gap : {0.002, 0.01}) {
+            World w;
+            kolize::MeshStageSettings settings;
+            settings.contact_margin = 0.005;
+            kolize::registerNarrowphase(&w.dispatcher, settings);
+            btRigidBody* ground = w.add(plane(), at(0, 0, 0), 0);
+            btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), at(0, 0, 0.5 + gap), 1);
+            w.world.performDiscreteCollisionDetection();
+            auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(ground, box));
+            ASSERT_NE(algorithm, nullptr);
+            const std::vector<kolize::MeshContact>& contacts = algorithm->lastContacts();
+            EXPECT_EQ(contacts.size(), gap < 0.005 ? 4u : 0u) << gap;
+            for (const kolize::MeshContact& c : contacts) {
+                EXPECT_NEAR(c.depth, -gap, 1e-6);  // apart: a negative depth, never penetration
+                EXPECT_LT((c.normal + up).norm(), 1e-6);
+            }
+        }
+    }
+}
+
 TEST(BulletMeshContacts, MultimaterialSceneryNamesEachContactsTriangleAndMaterial) {
     // Two 2 m x 2 m quads at z = 0, x < 0 of material 0 and x > 0 of material 1, wound up.
     btScalar vertices[] = {-2, -1, 0, 0, -1, 0, 0, 1, 0, -2, 1, 0, 2, -1, 0, 2, 1, 0};

@@ -327,16 +327,19 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 /// btHeightfieldTerrainShape and btStaticPlaneShape (Bullet itself has no
 /// algorithm for two concave shapes: without these a mesh body fell through a static plane
 /// or a heightfield). The scenery's processAllTriangles gives its triangles in the mesh's box
-/// (a plane: two triangles of a square fixed in the plane's frame that covers the box's
-/// projection, not Bullet's two centred on the box, which moved under a resting body); they
-/// become a small narrowphase mesh in world coordinates (vertices welded where exactly
-/// equal), queried exactly against the mesh. Its model (tree) is built, O(k log k) for k
-/// triangles, only when a call collects other triangles than the pair's last call did
-/// (compared bit for bit, O(k)); a body resting or sliding on scenery reuses it for many
-/// steps (MeshStageStats::scenery_models_built). Contacts as for two meshes, the scenery's
-/// part and triangle index on each point.
+/// (triangles with a corner that is not finite left out); they become a small narrowphase
+/// mesh in world coordinates (vertices welded where exactly equal), queried exactly against
+/// the mesh. Its model (tree) is built, O(k log k) for k triangles, only when a call collects
+/// other triangles than the pair's last call did (compared bit for bit, O(k)); a body resting
+/// or sliding on scenery reuses it for many steps (MeshStageStats::scenery_models_built).
+/// Contacts as for two meshes, the scenery's part and triangle index on each point.
+/// A static plane is a half-space, as for Bullet's convex shapes: the mesh's vertices on or
+/// below it are the candidates (or, when none is, those within the contact margin above),
+/// each at its own depth, normal along the plane's; up to 4 chosen as for two meshes, the
+/// plane's ids -1. O(vertices) per call once the mesh's bounding sphere reaches the plane.
 /// Time of impact (MeshContactAlgorithm): the mesh against the scenery's triangles in the
-/// box around the mesh at the start and at the end of the step (scenery frame); the scenery
+/// box around the mesh at the start and at the end of the step (scenery frame; a plane: two
+/// triangles of a square fixed in its frame that covers the box's projection); the scenery
 /// stays at its world transform (Bullet's triangle-mesh scenery is static).
 class BvhMeshAlgorithm : public MeshContactAlgorithm {
   public:
