@@ -1,6 +1,7 @@
 #include "kolize/narrowphase/bullet_mesh.h"
 
 #include "kolize/narrowphase/mesh_ccd.h"
+#include "kolize/narrowphase/triangle_test.h"
 
 #include "convex_ccd.h"
 #include <BulletCollision/CollisionShapes/btConvexShape.h>
@@ -1227,7 +1228,83 @@ bool noTimeOrHeld(CcdBuffers& s, const std::vector<Vec3>& normals, btCollisionOb
            !drivesIn(normals, s.movingA, s.movingB, ccdThresholdOfPair(*body0, *body1));
 }
 
-btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals,
+/// The distance between the features of `contact` where the piece starts (movingA and
+/// movingB's start positions).
+double startDistance(const ccd::MeshContact& contact, const ccd::MovingMesh& a,
+                     const ccd::MovingMesh& b) {
+    using narrowphase::Triangle;
+    auto corners = [](const ccd::MovingMesh& m, int t) {
+        const std::array<int, 3>& v = m.triangles[std::size_t(t)];
+        return Triangle{m.start[std::size_t(v[0])], m.start[std::size_t(v[1])],
+                        m.start[std::size_t(v[2])]};
+    };
+    auto point = [](const ccd::MovingMesh& m, int v) {
+        const Vec3& p = m.start[std::size_t(v)];
+        return Triangle{p, p, p};
+    };
+    auto segment = [](const ccd::MovingMesh& m, const std::array<int, 2>& e) {
+        const Vec3& p = m.start[std::size_t(e[0])];
+        const Vec3& q = m.start[std::size_t(e[1])];
+        return Triangle{p, q, q};
+    };
+    Triangle p, q;
+    switch (contact.features) {
+        case ccd::ContactFeatures::kVertexAFaceB:
+            p = point(a, contact.a[0]);
+            q = corners(b, contact.b[0]);
+            break;
+        case ccd::ContactFeatures::kFaceAVertexB:
+            p = corners(a, contact.a[0]);
+            q = point(b, contact.b[0]);
+            break;
+        case ccd::ContactFeatures::kEdgeEdge:
+            p = segment(a, contact.a);
+            q = segment(b, contact.b);
+            break;
+    }
+    return narrowphase::trianglesIntersect(p, q) ? 0.0
+                                                 : narrowphase::triangleDistance(p, q).distance;
+}
+
+/// How far the features of `contact` move into the other mesh over the piece: their
+/// displacement relative to each other (A's minus B's, each feature's mean) along the
+/// contact normal (from A towards B) that it follows most.
+double inwardMotion(const ccd::MeshContact& contact, const ccd::MovingMesh& a,
+                    const ccd::MovingMesh& b, const std::vector<Vec3>& normals) {
+    auto moved = [](const ccd::MovingMesh& m, const int* vertices, int count) {
+        Vec3 sum = Vec3::Zero();
+        for (int k = 0; k < count; ++k) {
+            sum += m.end[std::size_t(vertices[k])] - m.start[std::size_t(vertices[k])];
+        }
+        return Vec3(sum / count);
+    };
+    Vec3 relative = Vec3::Zero();
+    switch (contact.features) {
+        case ccd::ContactFeatures::kVertexAFaceB:
+            relative = moved(a, contact.a.data(), 1) -
+                       moved(b, b.triangles[std::size_t(contact.b[0])].data(), 3);
+            break;
+        case ccd::ContactFeatures::kFaceAVertexB:
+            relative = moved(a, a.triangles[std::size_t(contact.a[0])].data(), 3) -
+                       moved(b, contact.b.data(), 1);
+            break;
+        case ccd::ContactFeatures::kEdgeEdge:
+            relative = moved(a, contact.a.data(), 2) - moved(b, contact.b.data(), 2);
+            break;
+    }
+    double inward = -std::numeric_limits<double>::infinity();
+    for (const Vec3& normal : normals) {
+        inward = std::max(inward, relative.dot(normal));
+    }
+    return inward;
+}
+
+/// Contacts of features that already touch where a piece starts that a pair in contact may
+/// skip over the step: at most this many, then the next one counts (a stop too many rather
+/// than a body through).
+constexpr int kMaxTouchingSkipped = 8;
+
+btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, double touching,
                                btCollisionObject* body0, btCollisionObject* body1, bool& hit) {
     hit = false;
     if (noTimeOrHeld(s, normals, body0, body1)) {
@@ -1235,13 +1312,30 @@ btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals,
     }
     const double turn = std::max(turnOf(s.stepA), turnOf(s.stepB));
     const int pieces = std::clamp(int(std::ceil(turn / kMaxTurn)), 1, kMaxPieces);
+    int skipped = 0;
     for (int k = 0; k < pieces; ++k) {
         const double f0 = double(k) / pieces, f1 = double(k + 1) / pieces;
         if (pieces > 1 &&
             (!place(s.stepA, f0, f1, s.movingA) || !place(s.stepB, f0, f1, s.movingB))) {
             return btScalar(1);
         }
-        const ccd::MeshContact contact = ccd::meshCcd(s.movingA, s.movingB);
+        // A pair in contact: features that already touch (within `touching`) where the
+        // piece starts and do not move into each other along any of the contacts' normals
+        // are the contacts' (a vertex the solver lifts out of the other
+        // crosses its face on the way out, a sliding edge crosses the other's inner
+        // edges); their crossings are left to the contacts, and the search goes on after
+        // them for the first contact of the rest. (Counted as impacts, they stopped a body
+        // turning about its contact at once, every step, while its velocity grew.) A
+        // touching vertex driven on through a thin wall's far face still counts.
+        ccd::MeshCcdSettings settings;
+        ccd::MeshContact contact = ccd::meshCcd(s.movingA, s.movingB, settings);
+        while (contact.hit && !normals.empty() && skipped < kMaxTouchingSkipped &&
+               startDistance(contact, s.movingA, s.movingB) <= touching &&
+               !(inwardMotion(contact, s.movingA, s.movingB, normals) > 0)) {
+            ++skipped;
+            settings.primitive.min_time = contact.toi + settings.primitive.toi_tolerance;
+            contact = ccd::meshCcd(s.movingA, s.movingB, settings);
+        }
         if (!contact.hit) {
             continue;
         }
@@ -1265,11 +1359,15 @@ btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
                                                   btCollisionObject* body1) {
     State& s = *state_;
     std::vector<Vec3> normals;
+    double deepest = 0;
     for (const MeshContact& contact : s.contacts) {
         normals.push_back(contact.normal);
+        deepest = std::max(deepest, contact.depth);
     }
+    // Features within twice the pair's deepest contact of each other touch: its contacts'.
+    const double touching = 2 * deepest + 1e-9;
     bool hit = false;
-    const btScalar toi = piecewiseTimeOfImpact(s.ccd, normals, body0, body1, hit);
+    const btScalar toi = piecewiseTimeOfImpact(s.ccd, normals, touching, body0, body1, hit);
     if (hit) {
         s.stages.countTimeOfImpactHit();
     }
@@ -1472,16 +1570,19 @@ btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
     // The manifold's bodies are (convex, mesh): its normals on B point from the mesh (A
     // here) towards the convex (B here).
     c.normals.clear();
+    double deepest = 0;
     if (const btPersistentManifold* manifold = triangles_.m_manifoldPtr) {
         for (int i = 0; i < manifold->getNumContacts(); ++i) {
             c.normals.push_back(toVec3(manifold->getContactPoint(i).m_normalWorldOnB));
+            deepest = std::max(deepest, -double(manifold->getContactPoint(i).getDistance()));
         }
     }
+    const double touching = 2 * deepest + 1e-9;  // as in reportTimeOfImpact
     const btScalar fractionMesh = meshObject->getHitFraction();
     const btScalar fractionConvex = convexObject->getHitFraction();
     if (!(c.polytope.standoff > 0)) {
         bool hit = false;  // the surface is the shape's own faces
-        return piecewiseTimeOfImpact(c.buffers, c.normals, meshObject, convexObject, hit);
+        return piecewiseTimeOfImpact(c.buffers, c.normals, touching, meshObject, convexObject, hit);
     }
     // The surface stands off a round shape: advance to the shape itself, from the time
     // against the surface, or from the start when the mesh may start inside the surface
@@ -1501,7 +1602,7 @@ btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
         }
     } else {
         bool hit = false;
-        from = piecewiseTimeOfImpact(c.buffers, c.normals, meshObject, convexObject, hit);
+        from = piecewiseTimeOfImpact(c.buffers, c.normals, touching, meshObject, convexObject, hit);
         if (!hit) {
             return from;
         }
