@@ -208,6 +208,7 @@ struct ContactScratch {
     std::vector<Candidate> candidates;
     std::vector<Candidate> inside;          // vertices inside the other mesh, all patches
     std::vector<int> insideOfA, insideOfB;  // a vertex's entry in `inside`, -1 between calls
+    std::vector<double> heights;            // planeContacts' vertex heights
     std::vector<const PairContact*> sorted;
     std::vector<const NearPair*> sortedNear;
     std::vector<Vec3> outA, outB;  // each sorted pair's outward face normals (A's frame)
@@ -1299,6 +1300,43 @@ double inwardMotion(const ccd::MeshContact& contact, const ccd::MovingMesh& a,
     return inward;
 }
 
+/// Whether the plane of the features of `contact` where the piece starts (the face's, or
+/// the one both edges lie along) is within 45 degrees of one of the contact `normals`: the
+/// face or edges of a contact, not of another surface (a wall beside a floor).
+bool facesAContact(const ccd::MeshContact& contact, const ccd::MovingMesh& a,
+                   const ccd::MovingMesh& b, const std::vector<Vec3>& normals) {
+    auto faceNormal = [](const ccd::MovingMesh& m, int t) {
+        const std::array<int, 3>& v = m.triangles[std::size_t(t)];
+        const Vec3& p = m.start[std::size_t(v[0])];
+        return Vec3((m.start[std::size_t(v[1])] - p).cross(m.start[std::size_t(v[2])] - p));
+    };
+    auto edge = [](const ccd::MovingMesh& m, const std::array<int, 2>& e) {
+        return Vec3(m.start[std::size_t(e[1])] - m.start[std::size_t(e[0])]);
+    };
+    Vec3 across = Vec3::Zero();
+    switch (contact.features) {
+        case ccd::ContactFeatures::kVertexAFaceB:
+            across = faceNormal(b, contact.b[0]);
+            break;
+        case ccd::ContactFeatures::kFaceAVertexB:
+            across = faceNormal(a, contact.a[0]);
+            break;
+        case ccd::ContactFeatures::kEdgeEdge:
+            across = edge(a, contact.a).cross(edge(b, contact.b));
+            break;
+    }
+    const double size = across.norm();
+    if (!(size > 0)) {
+        return false;
+    }
+    for (const Vec3& normal : normals) {
+        if (std::fabs(across.dot(normal)) >= std::sqrt(0.5) * size * normal.norm()) {
+            return true;
+        }
+    }
+    return false;
+}
+
 /// Contacts of features that already touch where a piece starts that a pair in contact may
 /// skip over the step: at most this many, then the next one counts (a stop too many rather
 /// than a body through).
@@ -1320,8 +1358,8 @@ btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, 
             return btScalar(1);
         }
         // A pair in contact: features that already touch (within `touching`) where the
-        // piece starts and do not move into each other along any of the contacts' normals
-        // are the contacts' (a vertex the solver lifts out of the other
+        // piece starts, lie across one of the contacts' normals and do not move into each
+        // other along any of them are the contacts' (a vertex the solver lifts out of the other
         // crosses its face on the way out, a sliding edge crosses the other's inner
         // edges); their crossings are left to the contacts, and the search goes on after
         // them for the first contact of the rest. (Counted as impacts, they stopped a body
@@ -1331,9 +1369,14 @@ btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, 
         ccd::MeshContact contact = ccd::meshCcd(s.movingA, s.movingB, settings);
         while (contact.hit && !normals.empty() && skipped < kMaxTouchingSkipped &&
                startDistance(contact, s.movingA, s.movingB) <= touching &&
-               !(inwardMotion(contact, s.movingA, s.movingB, normals) > 0)) {
+               !(inwardMotion(contact, s.movingA, s.movingB, normals) > 0) &&
+               facesAContact(contact, s.movingA, s.movingB, normals)) {
             ++skipped;
             settings.primitive.min_time = contact.toi + settings.primitive.toi_tolerance;
+            if (!(settings.primitive.min_time < 1)) {
+                contact.hit = false;  // skipped to the piece's end
+                break;
+            }
             contact = ccd::meshCcd(s.movingA, s.movingB, settings);
         }
         if (!contact.hit) {
@@ -1342,6 +1385,71 @@ btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, 
         // Rounded down: the fraction handed to Bullet stays no later than the contact.
         const btScalar toi =
             std::clamp(roundOutward(f0 + contact.toi * (f1 - f0), false), btScalar(0), btScalar(1));
+        hit = true;
+        for (btCollisionObject* body : {body0, body1}) {
+            if (movesOverStep(*body) && body->getHitFraction() > toi) {
+                body->setHitFraction(toi);
+            }
+        }
+        return toi;
+    }
+    return btScalar(1);
+}
+
+/// The time of impact of a mesh body's step (s.stepA, world frame) with a static plane, a
+/// half-space as for its contacts (planeContacts): the first time a vertex of its triangles
+/// that starts above the plane by more than `touching` reaches it, on the chords of the
+/// step (the linear motion of each piece, as for meshCcd). Vertices already in the
+/// half-space or touching it are the contacts'; a pair in contact (`normals`, from the mesh
+/// into the plane) is left to them unless a vertex drives in along one by more than a CCD
+/// threshold.
+btScalar planeTimeOfImpact(const btStaticPlaneShape& plane, const btTransform& planeTransform,
+                           CcdBuffers& s, const std::vector<Index3>& triangles,
+                           const std::vector<Vec3>& normals, double touching,
+                           btCollisionObject* body0, btCollisionObject* body1, bool& hit) {
+    hit = false;
+    const Vec3 given = toVec3(plane.getPlaneNormal());
+    const double length = given.norm();
+    if (!(length > 0) || !std::isfinite(length) ||
+        !std::isfinite(double(plane.getPlaneConstant())) || !place(s.stepA, 0, 1, s.movingA)) {
+        return btScalar(1);
+    }
+    const Pose planePose = toPose(planeTransform);
+    const Vec3 n = planePose.rotation * (given / length);
+    const double c = double(plane.getPlaneConstant()) / length + n.dot(planePose.translation);
+    if (!normals.empty()) {
+        double forward = -std::numeric_limits<double>::infinity();
+        for (const Vec3& normal : normals) {
+            for (std::size_t i = 0; i < s.movingA.start.size(); ++i) {
+                forward = std::max(forward, (s.movingA.end[i] - s.movingA.start[i]).dot(normal));
+            }
+        }
+        if (!(forward > ccdThresholdOfPair(*body0, *body1))) {
+            return btScalar(1);
+        }
+    }
+    const int pieces = std::clamp(int(std::ceil(turnOf(s.stepA) / kMaxTurn)), 1, kMaxPieces);
+    for (int k = 0; k < pieces; ++k) {
+        const double f0 = double(k) / pieces, f1 = double(k + 1) / pieces;
+        if (pieces > 1 && !place(s.stepA, f0, f1, s.movingA)) {
+            return btScalar(1);
+        }
+        double first = 2;
+        for (const Index3& t : triangles) {
+            for (const std::int32_t v : t) {
+                const double h0 = n.dot(s.movingA.start[std::size_t(v)]) - c;
+                const double h1 = n.dot(s.movingA.end[std::size_t(v)]) - c;
+                if (h0 > touching && h1 <= 0) {
+                    first = std::min(first, h0 / (h0 - h1));
+                }
+            }
+        }
+        if (first > 1) {
+            continue;
+        }
+        // Rounded down, and a relative hair earlier: no later than the contact.
+        const btScalar toi = std::clamp(roundOutward(f0 + first * (1 - 1e-9) * (f1 - f0), false),
+                                        btScalar(0), btScalar(1));
         hit = true;
         for (btCollisionObject* body : {body0, body1}) {
             if (movesOverStep(*body) && body->getHitFraction() > toi) {
@@ -1657,14 +1765,15 @@ class SceneryCollector : public btTriangleCallback {
         add(local, partId, triangleIndex);
     }
     /// A triangle of corners in the scenery's frame. One with a corner that is not finite
-    /// there or in the world (a heightfield's NaN height) is left out, as Bullet's own
-    /// algorithms leave it: it meets nothing, and a mesh of it would be refused (MeshError,
-    /// which would unwind through Bullet's step).
+    /// there or in the world (a heightfield's NaN height), or beyond the mesh's coordinate
+    /// range, is left out, as Bullet's own algorithms leave it: it meets nothing, and a mesh
+    /// of it would be refused (MeshError, which would unwind through Bullet's step).
     void add(const Vec3 (&local)[3], int partId, int triangleIndex) {
         Vec3 world[3];
         for (int k = 0; k < 3; ++k) {
             world[k] = pose_.rotation * local[k] + pose_.translation;
-            if (!world[k].allFinite()) {
+            if (!world[k].allFinite() ||
+                world[k].cwiseAbs().maxCoeff() > TriangleMesh::kMaxCoordinate) {
                 return;
             }
         }
@@ -1698,45 +1807,11 @@ class SceneryCollector : public btTriangleCallback {
     Pose pose_;
 };
 
-/// The scenery's triangles that may meet the box [lo, hi] (its own frame) into `collector`.
-/// A static plane (for the time of impact only: its contacts are a half-space's, see
-/// planeContacts) gives two triangles of a square in it, fixed in the plane's frame: half
-/// side s, the power of two at or above the box's diagonal, centred on the multiple of s
-/// nearest the box's centre along the plane's two tangents. It covers the box's projection
-/// and stays the same while the body moves within it. (Bullet's own processAllTriangles
-/// centres its two triangles on the box, so their diagonal under a resting body moved with
-/// it every step.)
+/// The scenery's triangles that may meet the box [lo, hi] (its own frame) into `collector`
+/// (not a static plane's: a plane is a half-space, see planeContacts and planeTimeOfImpact).
 void collectScenery(const btConcaveShape& scenery, const btVector3& lo, const btVector3& hi,
                     SceneryCollector& collector) {
-    if (scenery.getShapeType() != STATIC_PLANE_PROXYTYPE) {
-        scenery.processAllTriangles(&collector, lo, hi);
-        return;
-    }
-    const auto& plane = static_cast<const btStaticPlaneShape&>(scenery);
-    const Vec3 n = toVec3(plane.getPlaneNormal());  // unit as Bullet stores it
-    const double n2 = n.squaredNorm();
-    if (!(n2 > 0)) {
-        return;  // no plane
-    }
-    const Vec3 foot = n * (double(plane.getPlaneConstant()) / n2);  // the plane's point nearest 0
-    const Vec3 centre = 0.5 * (toVec3(lo) + toVec3(hi));
-    const double half = std::exp2(std::ceil(
-        std::log2(std::max((toVec3(hi) - toVec3(lo)).norm(), std::numeric_limits<double>::min()))));
-    if (!std::isfinite(foot.squaredNorm() + centre.squaredNorm() + half)) {
-        return;  // nothing finite to meet
-    }
-    // Unit tangents p, q with p x q along n (btPlaneSpace1's choice, in double).
-    Vec3 p = std::fabs(n.z()) > std::sqrt(0.5) ? Vec3(0, -n.z(), n.y()) : Vec3(-n.y(), n.x(), 0);
-    p.normalize();
-    const Vec3 q = n.cross(p).normalized();
-    const Vec3 middle = foot + std::round((centre - foot).dot(p) / half) * half * p +
-                        std::round((centre - foot).dot(q) / half) * half * q;
-    const Vec3 a = middle - half * p - half * q, b = middle + half * p - half * q;
-    const Vec3 c = middle + half * p + half * q, d = middle - half * p + half * q;
-    const Vec3 first[3] = {a, b, c};  // wound about n
-    const Vec3 second[3] = {a, c, d};
-    collector.add(first, 0, 0);
-    collector.add(second, 0, 1);
+    scenery.processAllTriangles(&collector, lo, hi);
 }
 
 /// A static plane is a half-space, as Bullet's own algorithms take it for convex shapes:
@@ -1763,43 +1838,55 @@ bool planeContacts(const btStaticPlaneShape& plane, const Pose& planePose, const
     const Vec3 n = meshPose.rotation.transpose() * worldNormal;
     const double c = worldConstant - worldNormal.dot(meshPose.translation);
     const narrowphase::MeshModel& model = shape.model();
-    if (n.dot(model.sphere().center) - c - model.sphere().radius > margin) {
+    const std::vector<Index3>& triangles = model.mesh().triangles();
+    if (triangles.empty() || n.dot(model.sphere().center) - c - model.sphere().radius > margin) {
         return false;  // every vertex above the plane by more than the margin
     }
+    // The vertices of the triangles only (a vertex no triangle uses is no part of the
+    // body, nor in its bounding sphere). s.insideOfA marks them: -2 seen, -3 not a
+    // candidate, >= 0 the candidate's index; all -1 again on return.
     const std::vector<Vec3>& vertices = model.mesh().vertices();
-    double lowest = std::numeric_limits<double>::infinity();
-    for (const Vec3& v : vertices) {
-        lowest = std::min(lowest, n.dot(v) - c);
-    }
-    if (!(lowest <= margin)) {
-        return false;
-    }
-    const bool inside = lowest <= 0;
-    const double reach = inside ? 0.0 : margin;
     if (s.insideOfA.size() < vertices.size()) {
         s.insideOfA.resize(vertices.size(), -1);
     }
-    s.candidates.clear();
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        const double height = n.dot(vertices[i]) - c;
-        if (height <= reach) {
-            s.insideOfA[i] = int(s.candidates.size());
-            s.candidates.push_back(
-                {vertices[i] - (0.5 * height) * n, 0, TrianglePair{-1, -1}, -height});
-        }
+    if (s.heights.size() < vertices.size()) {
+        s.heights.resize(vertices.size());
     }
-    // Each point's triangle: the first of the mesh's triangles at its vertex.
-    const std::vector<Index3>& triangles = model.mesh().triangles();
-    for (std::size_t t = 0; t < triangles.size(); ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const int at = s.insideOfA[triangles[t][k]];
-            if (at >= 0 && s.candidates[at].ids.a < 0) {
-                s.candidates[at].ids.a = std::int32_t(t);
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Index3& t : triangles) {
+        for (const std::int32_t v : t) {
+            if (s.insideOfA[v] == -1) {
+                s.insideOfA[v] = -2;
+                s.heights[v] = n.dot(vertices[v]) - c;
+                lowest = std::min(lowest, s.heights[v]);
             }
         }
     }
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        s.insideOfA[i] = -1;
+    const bool inside = lowest <= 0;
+    const double reach = inside ? 0.0 : margin;
+    // Each point's triangle: the first of the mesh's triangles at its vertex.
+    s.candidates.clear();
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        for (const std::int32_t v : triangles[t]) {
+            if (s.insideOfA[v] == -2) {
+                const double height = s.heights[v];
+                if (height <= reach) {
+                    s.insideOfA[v] = int(s.candidates.size());
+                    s.candidates.push_back({vertices[v] - (0.5 * height) * n, 0,
+                                            TrianglePair{std::int32_t(t), -1}, -height});
+                } else {
+                    s.insideOfA[v] = -3;
+                }
+            }
+        }
+    }
+    for (const Index3& t : triangles) {
+        for (const std::int32_t v : t) {
+            s.insideOfA[v] = -1;
+        }
+    }
+    if (s.candidates.empty()) {
+        return false;  // lowest above the margin
     }
     Patch patch;
     patch.normal = -n;
@@ -1926,6 +2013,26 @@ btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCol
     if (!finitePose(meshObject->getWorldTransform()) || !finitePose(endOfStep(*meshObject)) ||
         !finitePose(sceneryPose)) {
         return btScalar(1);
+    }
+    if (scenery->getShapeType() == STATIC_PLANE_PROXYTYPE) {
+        const TriangleMesh& mesh = shape->model().mesh();
+        if (!stepOf(*meshObject, mesh.vertices(), state_->ccd.stepA)) {
+            return btScalar(1);
+        }
+        std::vector<Vec3> normals;
+        double deepest = 0;
+        for (const MeshContact& contact : state_->contacts) {
+            normals.push_back(contact.normal);
+            deepest = std::max(deepest, contact.depth);
+        }
+        bool hit = false;
+        const btScalar toi = planeTimeOfImpact(static_cast<const btStaticPlaneShape&>(*scenery),
+                                               sceneryPose, state_->ccd, mesh.triangles(), normals,
+                                               2 * deepest + 1e-9, body0, body1, hit);
+        if (hit) {
+            state_->stages.countTimeOfImpactHit();
+        }
+        return toi;
     }
     btVector3 lo, hi;
     sweptBoxIn(*shape, *meshObject, sceneryPose, lo, hi);

@@ -311,6 +311,55 @@ TEST(BulletMeshTimeOfImpact, PairsInContactAtTheStartAreLeftToTheContactsUnlessD
     EXPECT_EQ(pair.timeOfImpact(), btScalar(1));
 }
 
+/// A box 3 cm deep in a floor slides fast at a 2 cm wall of the same mesh, 5 cm away. Its
+/// contacts are the floor's; the features that touch where the step starts and do not move
+/// into each other along those contacts' normals are left to them, but only those lying
+/// across a contact's normal: the box's face 5 cm from the wall, within twice the contact's
+/// depth and moving along the floor, once counted as touching, and the box went through.
+TEST(BulletMeshTimeOfImpact, AContactOnTheFloorDoesNotHideTheWallBesideIt) {
+    // One mesh: a floor slab (top at y = 0) and a wall of it (x from 0.55 to 0.57).
+    const TriangleMesh slab = boxMesh(Vec3(2, 0.05, 2));
+    const TriangleMesh wall = boxMesh(Vec3(0.01, 1, 2));
+    std::vector<Vec3> vertices;
+    std::vector<Index3> triangles;
+    for (const auto& [mesh, offset] :
+         {std::pair{&slab, Vec3(0, -0.05, 0)}, std::pair{&wall, Vec3(0.56, 1, 0)}}) {
+        const auto base = std::int32_t(vertices.size());
+        for (const Vec3& v : mesh->vertices()) {
+            vertices.push_back(v + offset);
+        }
+        for (const Index3& t : mesh->triangles()) {
+            triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+        }
+    }
+    auto ground = std::make_shared<MeshShape>(
+        kolize::makeMeshModel(TriangleMesh("floor and wall", vertices, triangles)));
+    Pair pair(meshBox(Vec3::Constant(0.5)), 1, ground, 0);
+    Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));
+    // 3 cm into the floor, 5 cm from the wall, beside the floor's top diagonal (z = x).
+    const btTransform start = at(0, 0.47, -1.2);
+    const btCollisionObjectWrapper wrapA(nullptr, pair.shapeA_.get(), pair.a.get(), start, -1, -1);
+    const btCollisionObjectWrapper wrapB(nullptr, pair.shapeB_.get(), pair.b.get(),
+                                         pair.b->getWorldTransform(), -1, -1);
+    btManifoldResult result(&wrapA, &wrapB);
+    pair.algorithm->processCollision(&wrapA, &wrapB, pair.dispatchInfo, &result);
+    const auto& contacts =
+        static_cast<kolize::MeshContactAlgorithm*>(pair.algorithm)->lastContacts();
+    ASSERT_FALSE(contacts.empty());
+    for (const kolize::MeshContact& contact : contacts) {
+        ASSERT_GT(std::fabs(contact.normal.y()), 0.99);  // the floor's only
+        ASSERT_GT(contact.depth, 0.025);                 // 3 cm: touching reaches 6 cm
+    }
+    // 1 m along x, turning 0.1 rad about z: its back edge drives 5 cm into the floor (so
+    // CCD runs), its front face rises and reaches the wall at about 0.05 of the step.
+    btTransform end = at(1, 0.47, -1.2);
+    end.setRotation(btQuaternion(btVector3(0, 0, 1), btScalar(0.1)));
+    Pair::move(*pair.a, start, end);
+    const btScalar toi = pair.timeOfImpact();
+    EXPECT_LE(toi, btScalar(0.05));
+    EXPECT_GT(toi, btScalar(0.03));
+}
+
 TEST(BulletMeshTimeOfImpact, BadMotionNeverCrashes) {
     Pair pair(meshBox(kBoxHalf), 1, meshBox(kWallHalf), 0);
     Pair::move(*pair.b, at(0, 0, 0), at(0, 0, 0));

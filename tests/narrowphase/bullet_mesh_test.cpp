@@ -1642,6 +1642,33 @@ TEST(BulletMeshContacts, AStaticPlaneIsAHalfSpace) {
             EXPECT_GE(c.triangleX, 0);
         }
     }
+    {  // A plane body turned and moved: the plane n . x = 0.1 of its frame, in the world.
+        World w;
+        btTransform planeAt = at(1, 2, 3);
+        planeAt.setRotation(btQuaternion(btVector3(1, 0.2, 0).normalized(), btScalar(0.3)));
+        btRigidBody* ground = w.add(
+            std::make_shared<btStaticPlaneShape>(btVector3(0, 0, 1), btScalar(0.1)), planeAt, 0);
+        const btVector3 worldUp = planeAt.getBasis() * btVector3(0, 0, 1);
+        const Vec3 n = toVec3(worldUp).normalized();
+        const double offset = 0.1 + n.dot(toVec3(planeAt.getOrigin()));
+        // A box turned as above with its centre 1 cm below the plane.
+        btTransform pose = tiltedAt(0);
+        pose.setOrigin(btVector3(btScalar(0.5), btScalar(1.5), btScalar(0)));
+        const double shift = offset - n.dot(toVec3(pose.getOrigin())) - 0.01;
+        pose.setOrigin(pose.getOrigin() + worldUp * btScalar(shift));
+        btRigidBody* box = w.add(boxShape(Vec3::Constant(0.5)), pose, 1);
+        w.world.performDiscreteCollisionDetection();
+        auto* algorithm = dynamic_cast<kolize::BvhMeshAlgorithm*>(w.algorithm(ground, box));
+        ASSERT_NE(algorithm, nullptr);
+        const std::vector<double> corners = cornerHeights(pose, n, offset);
+        const std::vector<kolize::MeshContact>& contacts = algorithm->lastContacts();
+        ASSERT_EQ(contacts.size(), 4u);
+        EXPECT_NEAR(contacts.front().depth, -corners.front(), 1e-5);
+        for (const kolize::MeshContact& c : contacts) {
+            EXPECT_LT((c.normal + n).norm(), 1e-5);
+            EXPECT_NEAR(n.dot(c.point) - offset, -0.5 * c.depth, 1e-5);
+        }
+    }
     // Pushed out as Bullet pushes its own box out, from 1 cm, 20 cm and wholly below.
     for (double z : {-0.01, -0.2, -0.6}) {
         SCOPED_TRACE(z);
@@ -1765,8 +1792,12 @@ TEST(BulletMeshContacts, MultimaterialSceneryNamesEachContactsTriangleAndMateria
         for (int k = 0; k < manifold->getNumContacts(); ++k) {
             const btManifoldPoint& p = manifold->getContactPoint(k);
             const bool floorFirst = manifold->getBody0() == floor;
-            const btMaterial* material = shape->getMaterialProperties(
-                floorFirst ? p.m_partId0 : p.m_partId1, floorFirst ? p.m_index0 : p.m_index1);
+            const int part = floorFirst ? p.m_partId0 : p.m_partId1;
+            const int index = floorFirst ? p.m_index0 : p.m_index1;
+            ASSERT_EQ(part, 0);
+            ASSERT_GE(index, 0);
+            ASSERT_LT(index, 4);
+            const btMaterial* material = shape->getMaterialProperties(part, index);
             const double pointX = 0.5 * (p.getPositionWorldOnA().x() + p.getPositionWorldOnB().x());
             EXPECT_EQ(material->m_friction, pointX < 0 ? btScalar(0.1) : btScalar(0.9)) << pointX;
         }

@@ -333,14 +333,16 @@ class ConvexMeshAlgorithm : public btActivatingCollisionAlgorithm {
 /// other triangles than the pair's last call did (compared bit for bit, O(k)); a body resting
 /// or sliding on scenery reuses it for many steps (MeshStageStats::scenery_models_built).
 /// Contacts as for two meshes, the scenery's part and triangle index on each point.
-/// A static plane is a half-space, as for Bullet's convex shapes: the mesh's vertices on or
-/// below it are the candidates (or, when none is, those within the contact margin above),
-/// each at its own depth, normal along the plane's; up to 4 chosen as for two meshes, the
-/// plane's ids -1. O(vertices) per call once the mesh's bounding sphere reaches the plane.
+/// A static plane is a half-space, as for Bullet's convex shapes: the vertices of the mesh's
+/// triangles on or below it are the candidates (or, when none is, those within the contact
+/// margin above), each at its own depth, normal along the plane's; up to 4 chosen as for two
+/// meshes, the plane's ids -1. O(vertices + triangles) per call once the mesh's bounding
+/// sphere reaches the plane.
 /// Time of impact (MeshContactAlgorithm): the mesh against the scenery's triangles in the
-/// box around the mesh at the start and at the end of the step (scenery frame; a plane: two
-/// triangles of a square fixed in its frame that covers the box's projection); the scenery
-/// stays at its world transform (Bullet's triangle-mesh scenery is static).
+/// box around the mesh at the start and at the end of the step (scenery frame); the scenery
+/// stays at its world transform (Bullet's triangle-mesh scenery is static). Against a plane:
+/// the first time a vertex that starts above it reaches it (vertices already on or in it are
+/// the contacts').
 class BvhMeshAlgorithm : public MeshContactAlgorithm {
   public:
     BvhMeshAlgorithm(const btCollisionAlgorithmConstructionInfo& ci,
