@@ -1267,6 +1267,18 @@ double startDistance(const ccd::MeshContact& contact, const ccd::MovingMesh& a,
                                                  : narrowphase::triangleDistance(p, q).distance;
 }
 
+/// The fraction of the step handed to Bullet for a contact at `fraction`: rounded down, so
+/// no later than the contact; each moving body's hit fraction at most that.
+btScalar stopAt(double fraction, btCollisionObject* body0, btCollisionObject* body1) {
+    const btScalar toi = std::clamp(roundOutward(fraction, false), btScalar(0), btScalar(1));
+    for (btCollisionObject* body : {body0, body1}) {
+        if (movesOverStep(*body) && body->getHitFraction() > toi) {
+            body->setHitFraction(toi);
+        }
+    }
+    return toi;
+}
+
 /// How far the features of `contact` move into the other mesh over the piece: their
 /// displacement relative to each other (A's minus B's, each feature's mean) along the
 /// contact normal (from A towards B) that it follows most.
@@ -1382,16 +1394,8 @@ btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, 
         if (!contact.hit) {
             continue;
         }
-        // Rounded down: the fraction handed to Bullet stays no later than the contact.
-        const btScalar toi =
-            std::clamp(roundOutward(f0 + contact.toi * (f1 - f0), false), btScalar(0), btScalar(1));
         hit = true;
-        for (btCollisionObject* body : {body0, body1}) {
-            if (movesOverStep(*body) && body->getHitFraction() > toi) {
-                body->setHitFraction(toi);
-            }
-        }
-        return toi;
+        return stopAt(f0 + contact.toi * (f1 - f0), body0, body1);
     }
     return btScalar(1);
 }
@@ -1447,16 +1451,8 @@ btScalar planeTimeOfImpact(const btStaticPlaneShape& plane, const btTransform& p
         if (first > 1) {
             continue;
         }
-        // Rounded down, and a relative hair earlier: no later than the contact.
-        const btScalar toi = std::clamp(roundOutward(f0 + first * (1 - 1e-9) * (f1 - f0), false),
-                                        btScalar(0), btScalar(1));
         hit = true;
-        for (btCollisionObject* body : {body0, body1}) {
-            if (movesOverStep(*body) && body->getHitFraction() > toi) {
-                body->setHitFraction(toi);
-            }
-        }
-        return toi;
+        return stopAt(f0 + first * (1 - 1e-9) * (f1 - f0), body0, body1);  // a hair earlier
     }
     return btScalar(1);
 }

@@ -897,8 +897,7 @@ TEST(BulletMeshCcdWorld, ABodyTurningAboutItsContactIsNotPinned) {
             groundShape = std::make_shared<btStaticPlaneShape>(btVector3(0, 1, 0), 0);
         } else if (ground == 1) {
             groundShape = std::make_shared<btHeightfieldTerrainShape>(
-                32, 32, heights.data(), btScalar(1), btScalar(-1), btScalar(1), 1, PHY_FLOAT,
-                false);
+                32, 32, heights.data(), btScalar(-1), btScalar(1), 1, false);
         } else {
             groundShape = std::make_shared<btBvhTriangleMeshShape>(&floorTriangles, true);
         }

@@ -1714,7 +1714,7 @@ TEST(BulletMeshContacts, AStaticPlaneIsAHalfSpace) {
                                 double(box->getAngularVelocity().length())});
         }
         EXPECT_LT(fastest, 1e-3);
-        EXPECT_LT((box->getWorldTransform().getOrigin() - settled).length(), 1e-4);
+        EXPECT_LT((box->getWorldTransform().getOrigin() - settled).length(), 1e-3);
     }
     {  // A contact margin: a box 2 mm above gets separated contacts, one 1 cm above none.
         for (double gap : {0.002, 0.01}) {
@@ -1828,10 +1828,9 @@ TEST(BulletMeshContacts, NonFiniteSceneryTrianglesAreLeftOut) {
             heights[0] = nan;
         }
         World w;
-        w.add(
-            std::make_shared<btHeightfieldTerrainShape>(
-                4, 4, heights.data(), btScalar(1), btScalar(-1), btScalar(1), 2, PHY_FLOAT, false),
-            at(0, 0, 0), 0);
+        w.add(std::make_shared<btHeightfieldTerrainShape>(4, 4, heights.data(), btScalar(-1),
+                                                          btScalar(1), 2, false),
+              at(0, 0, 0), 0);
         // Over the far corner's quad, and one across the quads around the NaN sample.
         btRigidBody* far = w.add(boxShape(Vec3::Constant(0.3)), at(0.8, 0.8, 0.35), 1);
         btRigidBody* near = w.add(boxShape(Vec3::Constant(0.3)), at(-1.3, -1.3, 0.35), 1);
