@@ -1354,6 +1354,12 @@ bool facesAContact(const ccd::MeshContact& contact, const ccd::MovingMesh& a,
 /// than a body through).
 constexpr int kMaxTouchingSkipped = 8;
 
+/// Features of a pair in contact within this distance of each other where the step starts
+/// touch (are its contacts'): twice the pair's deepest contact.
+double touchingWithin(double deepest) {
+    return 2 * deepest + 1e-9;
+}
+
 btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, double touching,
                                btCollisionObject* body0, btCollisionObject* body1, bool& hit) {
     hit = false;
@@ -1400,6 +1406,31 @@ btScalar piecewiseTimeOfImpact(CcdBuffers& s, const std::vector<Vec3>& normals, 
     return btScalar(1);
 }
 
+/// The plane of `plane` at `planePose` in the world, n . x = c with n unit; false for a
+/// normal that is zero or not finite, or a constant that is not finite.
+bool worldPlane(const btStaticPlaneShape& plane, const Pose& planePose, Vec3& n, double& c) {
+    const Vec3 given = toVec3(plane.getPlaneNormal());
+    const double length = given.norm();
+    if (!(length > 0) || !std::isfinite(length) ||
+        !std::isfinite(double(plane.getPlaneConstant()))) {
+        return false;
+    }
+    n = planePose.rotation * (given / length);
+    c = double(plane.getPlaneConstant()) / length + n.dot(planePose.translation);
+    return true;
+}
+
+/// The normals of a pair's contacts at the start of the step (`normals`), and the distance
+/// within which features touch: twice the deepest contact's depth.
+double touchingOfContacts(const std::vector<MeshContact>& contacts, std::vector<Vec3>& normals) {
+    double deepest = 0;
+    for (const MeshContact& contact : contacts) {
+        normals.push_back(contact.normal);
+        deepest = std::max(deepest, contact.depth);
+    }
+    return touchingWithin(deepest);
+}
+
 /// The time of impact of a mesh body's step (s.stepA, world frame) with a static plane, a
 /// half-space as for its contacts (planeContacts): the first time a vertex of its triangles
 /// that starts above the plane by more than `touching` reaches it, on the chords of the
@@ -1412,15 +1443,11 @@ btScalar planeTimeOfImpact(const btStaticPlaneShape& plane, const btTransform& p
                            const std::vector<Vec3>& normals, double touching,
                            btCollisionObject* body0, btCollisionObject* body1, bool& hit) {
     hit = false;
-    const Vec3 given = toVec3(plane.getPlaneNormal());
-    const double length = given.norm();
-    if (!(length > 0) || !std::isfinite(length) ||
-        !std::isfinite(double(plane.getPlaneConstant())) || !place(s.stepA, 0, 1, s.movingA)) {
+    Vec3 n;
+    double c = 0;
+    if (!worldPlane(plane, toPose(planeTransform), n, c) || !place(s.stepA, 0, 1, s.movingA)) {
         return btScalar(1);
     }
-    const Pose planePose = toPose(planeTransform);
-    const Vec3 n = planePose.rotation * (given / length);
-    const double c = double(plane.getPlaneConstant()) / length + n.dot(planePose.translation);
     if (!normals.empty()) {
         double forward = -std::numeric_limits<double>::infinity();
         for (const Vec3& normal : normals) {
@@ -1463,13 +1490,7 @@ btScalar MeshContactAlgorithm::reportTimeOfImpact(btCollisionObject* body0,
                                                   btCollisionObject* body1) {
     State& s = *state_;
     std::vector<Vec3> normals;
-    double deepest = 0;
-    for (const MeshContact& contact : s.contacts) {
-        normals.push_back(contact.normal);
-        deepest = std::max(deepest, contact.depth);
-    }
-    // Features within twice the pair's deepest contact of each other touch: its contacts'.
-    const double touching = 2 * deepest + 1e-9;
+    const double touching = touchingOfContacts(s.contacts, normals);
     bool hit = false;
     const btScalar toi = piecewiseTimeOfImpact(s.ccd, normals, touching, body0, body1, hit);
     if (hit) {
@@ -1681,7 +1702,7 @@ btScalar ConvexMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0,
             deepest = std::max(deepest, -double(manifold->getContactPoint(i).getDistance()));
         }
     }
-    const double touching = 2 * deepest + 1e-9;  // as in reportTimeOfImpact
+    const double touching = touchingWithin(deepest);
     const btScalar fractionMesh = meshObject->getHitFraction();
     const btScalar fractionConvex = convexObject->getHitFraction();
     if (!(c.polytope.standoff > 0)) {
@@ -1821,16 +1842,12 @@ void collectScenery(const btConcaveShape& scenery, const btVector3& lo, const bt
 bool planeContacts(const btStaticPlaneShape& plane, const Pose& planePose, const MeshShape& shape,
                    const Pose& meshPose, double margin, double separation, ContactScratch& s,
                    std::vector<MeshContact>& out) {
-    const Vec3 given = toVec3(plane.getPlaneNormal());
-    const double length = given.norm();
-    if (!(length > 0) || !std::isfinite(length) ||
-        !std::isfinite(double(plane.getPlaneConstant()))) {
+    // The plane n . x = c in the world, then in the mesh's frame.
+    Vec3 worldNormal;
+    double worldConstant = 0;
+    if (!worldPlane(plane, planePose, worldNormal, worldConstant)) {
         return false;  // no plane
     }
-    // The plane n . x = c in the world, then in the mesh's frame.
-    const Vec3 worldNormal = planePose.rotation * (given / length);
-    const double worldConstant =
-        double(plane.getPlaneConstant()) / length + worldNormal.dot(planePose.translation);
     const Vec3 n = meshPose.rotation.transpose() * worldNormal;
     const double c = worldConstant - worldNormal.dot(meshPose.translation);
     const narrowphase::MeshModel& model = shape.model();
@@ -2016,15 +2033,11 @@ btScalar BvhMeshAlgorithm::calculateTimeOfImpact(btCollisionObject* body0, btCol
             return btScalar(1);
         }
         std::vector<Vec3> normals;
-        double deepest = 0;
-        for (const MeshContact& contact : state_->contacts) {
-            normals.push_back(contact.normal);
-            deepest = std::max(deepest, contact.depth);
-        }
+        const double touching = touchingOfContacts(state_->contacts, normals);
         bool hit = false;
-        const btScalar toi = planeTimeOfImpact(static_cast<const btStaticPlaneShape&>(*scenery),
-                                               sceneryPose, state_->ccd, mesh.triangles(), normals,
-                                               2 * deepest + 1e-9, body0, body1, hit);
+        const btScalar toi =
+            planeTimeOfImpact(static_cast<const btStaticPlaneShape&>(*scenery), sceneryPose,
+                              state_->ccd, mesh.triangles(), normals, touching, body0, body1, hit);
         if (hit) {
             state_->stages.countTimeOfImpactHit();
         }
