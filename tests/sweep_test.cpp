@@ -60,6 +60,7 @@ struct Tracked {
     std::size_t frames = 0, pairsSeen = 0, reusedBeforeMaintain = 0, changes = 0;
     std::size_t oneAxisMoves = 0, oneEndMoves = 0;
     std::size_t batched = 0, oneByOne = 0;  ///< the core's counters at the end
+    std::size_t writtenAtUpdate = 0;
 };
 
 /// `opsPerFrame` random operations between two maintain() calls, `frames` times.
@@ -157,6 +158,7 @@ Tracked runTracked(std::uint32_t seed, bool lattice, int opsPerFrame, int frames
     }
     out.batched = core.batchedSearches();
     out.oneByOne = core.oneByOneSearches();
+    out.writtenAtUpdate = core.movesWrittenAtUpdate();
     return out;
 }
 
@@ -181,6 +183,11 @@ TEST(SweepTracking, DrainedChangesKeepTheExactPairsUnderMovesJitterAndReusedIds)
                 EXPECT_GT(t.oneEndMoves, 500u);
                 // The frames took the way of applying moves this mode is for.
                 EXPECT_GT(mode.batched ? t.batched : t.oneByOne, std::size_t(mode.frames) * 9 / 10);
+                // After a batch the next frame's moves are written at update() (removals
+                // and re-used ids among them).
+                if (mode.batched) {
+                    EXPECT_GT(t.writtenAtUpdate, std::size_t(mode.frames) * 20);
+                }
             }
         }
     }
@@ -311,6 +318,7 @@ void runUnsortedRuns(std::uint32_t seed) {
     std::set<Pair> tracked;
     std::vector<kolize::ObjectId> away;
     std::size_t queries = 0, queryHits = 0, bigMoves = 0, created = 0, removed = 0;
+    std::size_t midFrameHits = 0;
     for (int frame = 0; frame < 240; ++frame) {
         const int kind = frame % 12;
         if (kind == 5) {  // a few objects move far, one at a time, and come back next frame
@@ -371,6 +379,28 @@ void runUnsortedRuns(std::uint32_t seed) {
                 core.update(id, boxes[id]);
             }
         }
+        {
+            // Before the search: the moves may sit written where their endpoints were (after
+            // a frame of many moves), or wait in the moved list. A query still finds every
+            // object that meets it (a superset), and the structure still validates.
+            core.validate();
+            SBox query;
+            query.lo[0] = Scalar(std::floor(9 * unit(rng)) - 0.02);
+            query.hi[0] = query.lo[0] + Scalar(0.04 + unit(rng));
+            query.lo[1] = query.lo[2] = -10;
+            query.hi[1] = query.hi[2] = 10;
+            std::set<kolize::ObjectId> seen;
+            core.queryBox(query, [&](kolize::ObjectId id) { seen.insert(id); });
+            for (kolize::ObjectId id = 0; id < kSlots; ++id) {
+                if (live[id] && !(boxes[id].hi[0] < query.lo[0]) &&
+                    !(query.hi[0] < boxes[id].lo[0])) {
+                    ASSERT_EQ(seen.count(id), 1u)
+                        << "seed " << seed << ", frame " << frame << ": object " << id
+                        << " missed by a query before the search";
+                    ++midFrameHits;
+                }
+            }
+        }
         drainInto(core, boxes, tracked);
         std::set<Pair> truth;
         for (kolize::ObjectId a = 0; a < kSlots; ++a) {
@@ -410,6 +440,10 @@ void runUnsortedRuns(std::uint32_t seed) {
     // Meaningful: passes were left out, the other paths all ran, the queries found objects.
     EXPECT_GT(core.passesLeftOut(), 300u);
     EXPECT_GT(core.oneByOneSearches(), 10u);
+    // Jitter frames wrote the next frame's moves at update() (every live object, 8 frames in
+    // 12), and the far moves after them too (3 objects, a batch of few).
+    EXPECT_GT(core.movesWrittenAtUpdate(), 100u * 140u);
+    EXPECT_GT(midFrameHits, 240u * 10u);
     EXPECT_GT(bigMoves, 20u);
     EXPECT_GT(created, 10u);
     EXPECT_GT(removed, 10u);

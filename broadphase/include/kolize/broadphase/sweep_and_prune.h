@@ -11,10 +11,10 @@
 /// overlapping on that axis, and when their other axes overlap, the pair is recorded as
 /// changed. Moves are applied at the next pair search (maintain()): one object at a time
 /// when under one in eight moved, else one insertion pass per axis (a jittering stack's
-/// tied endpoints swap in a contiguous array), and none on an axis where no min passed a
-/// max. Work per frame: O(moved objects + swaps), plus O(N) per changed axis for a pass or
-/// its check; objects at rest cost nothing, and an axis on which no moved box changed its
-/// interval is not touched.
+/// tied endpoints swap in a contiguous array; after such a frame update() writes the new
+/// values at once), and none on an axis where no min passed a max. Work per frame: O(moved objects
+/// + swaps), plus O(N) per changed axis for a pass or its check; objects at rest cost nothing, and
+/// an axis on which no moved box changed its interval is not touched.
 ///
 /// Unlike btAxisSweep3: the endpoints are the exact box coordinates (no quantisation, so no
 /// world bounds and no extra pairs), ids are 32-bit (no 16-bit handle limit), and objects
@@ -80,10 +80,18 @@ class SweepAndPrune {
 
     /// Moves object `id` to `box`, applied at the next maintain() (or pair search): there
     /// the moved objects' endpoints swap their way to the new values, one object at a time
-    /// when few moved, else in one insertion pass per axis (see applyMoves).
+    /// when few moved, else in one insertion pass per axis (see applyMoves). After a search
+    /// in which many moved, the next frame's moves write their endpoints' values at once,
+    /// where the endpoints are (the pass restores the order): the object is then touched
+    /// once per frame, not once here and once more at the search.
     void update(ObjectId id, const Box& box) {
         if (state_[id] == State::Pending) {
             boxes_[id] = box;
+            return;
+        }
+        if (writeAtUpdate_ && state_[id] == State::Sorted) {
+            writeValues(id, box);
+            ++writtenMoves_;
             return;
         }
         next_[id] = box;
@@ -112,8 +120,10 @@ class SweepAndPrune {
     /// and merges the created ones in, recording every pair of a merged object whose boxes
     /// overlap.
     void maintain() {
-        if (!moved_.empty()) {
+        if (!moved_.empty() || writtenMoves_ > 0) {
             applyMoves();
+        } else {
+            writeAtUpdate_ = false;  // a frame without moves: the next may have a few
         }
         if (dead_ > 0) {
             compact();
@@ -161,9 +171,19 @@ class SweepAndPrune {
     }
 
     /// Objects whose first-axis interval meets the box's (a superset; pending objects and
-    /// objects moved since the last maintain() all, once each).
+    /// objects moved since the last maintain() all, once each; every object while moves
+    /// written at update() wait for their pass).
     template <class Visit>
     void queryBox(const Box& box, Visit&& visit) const {
+        if (writtenMoves_ > 0) {
+            // The arrays hold new values at old places: no order to stop the scan by.
+            for (ObjectId id = 0; id < state_.size(); ++id) {
+                if (state_[id] == State::Sorted || state_[id] == State::Pending) {
+                    visit(id);
+                }
+            }
+            return;
+        }
         for (ObjectId id : pending_) {
             visit(id);
         }
@@ -210,10 +230,13 @@ class SweepAndPrune {
     std::size_t batchedSearches() const { return batchedSearches_; }
     /// Axis passes left out because no min passed a max (see applyMoves).
     std::size_t passesLeftOut() const { return passesLeftOut_; }
+    /// Moves whose endpoint values update() wrote at once (see update).
+    std::size_t movesWrittenAtUpdate() const { return movesWrittenAtUpdate_; }
     std::size_t oneByOneSearches() const { return oneByOneSearches_; }
 
-    /// Checks the arrays' order, the endpoint positions and values against the boxes, and
-    /// the counts; throws std::logic_error.
+    /// Checks the arrays' order (unless moves written at update() wait for their pass), the
+    /// endpoint positions and values against the boxes, and the counts; throws
+    /// std::logic_error.
     void validate() const {
         auto fail = [](const std::string& what) {
             throw std::logic_error("SweepAndPrune: " + what);
@@ -250,11 +273,11 @@ class SweepAndPrune {
         for (int axis = 0; axis < D; ++axis) {
             const std::vector<Endpoint>& edges = axes_[axis];
             bool inOrder = true;
-            if (!sweep_detail::kindOrderHolds(axes_[axis], inOrder)) {
+            if (!sweep_detail::kindOrderHolds(axes_[axis], inOrder) && writtenMoves_ == 0) {
                 fail("axis " + std::to_string(axis) +
                      " orders a min and a max against their values");
             }
-            if (sorted_[axis] && !inOrder) {
+            if (sorted_[axis] && !inOrder && writtenMoves_ == 0) {
                 fail("axis " + std::to_string(axis) + " marked sorted but is not");
             }
             std::size_t deadEdges = 0;
@@ -353,13 +376,19 @@ class SweepAndPrune {
     /// (new for the axes already sorted, old for the others). A pair that stops overlapping
     /// is recorded at its first change (every other relation still as before: overlapping);
     /// one that starts, at its last (every other relation already as after).
+    ///
+    /// Whether the next frame's moves write their values at update(): when this one's were
+    /// many. A frame of few moves that finds them written takes the passes all the same,
+    /// and the one after goes one at a time again.
     void applyMoves() {
-        std::size_t live = 0;
+        std::size_t live = writtenMoves_;
         for (ObjectId id : moved_) {
             live += state_[id] == State::Sorted ? 1 : 0;
         }
         const std::size_t sorted = size_ - pending_.size();
-        if (live * kBatchFrom < sorted) {
+        const bool many = live * kBatchFrom >= sorted;
+        movesWrittenAtUpdate_ += writtenMoves_;
+        if (writtenMoves_ == 0 && !many) {
             sortAxes();  // moveOne's swaps stop at the first neighbour in order
             for (ObjectId id : moved_) {
                 dirty_[id] = 0;
@@ -369,28 +398,17 @@ class SweepAndPrune {
             }
             ++oneByOneSearches_;
         } else {
-            bool changed[D] = {};
             for (ObjectId id : moved_) {
                 dirty_[id] = 0;
-                if (state_[id] != State::Sorted) {
-                    continue;
+                if (state_[id] == State::Sorted) {
+                    writeValues(id, next_[id]);
                 }
-                Box& old = boxes_[id];
-                const Box& box = next_[id];
-                for (int axis = 0; axis < D; ++axis) {
-                    if (old.lo[axis] == box.lo[axis] && old.hi[axis] == box.hi[axis]) {
-                        continue;
-                    }
-                    axes_[axis][at_[id][2 * axis]].setValue(box.lo[axis]);
-                    axes_[axis][at_[id][2 * axis + 1]].setValue(box.hi[axis]);
-                    changed[axis] = true;
-                }
-                old = box;
             }
             for (int axis = 0; axis < D; ++axis) {
-                if (!changed[axis]) {
+                if (!valuesChanged_[axis]) {
                     continue;
                 }
+                valuesChanged_[axis] = false;
                 // An axis whose last check failed (a pile: ends of both kinds pass each
                 // other every frame) is checked again only after 8 passes.
                 bool inOrder = false;
@@ -410,7 +428,26 @@ class SweepAndPrune {
             }
             ++batchedSearches_;
         }
+        writeAtUpdate_ = many;
+        writtenMoves_ = 0;
         moved_.clear();
+    }
+
+    /// A batch's move: the object's endpoints take the new values where they are (an axis
+    /// whose interval did not change is left alone, and its pass too if no object changed
+    /// there).
+    void writeValues(ObjectId id, const Box& box) {
+        Box& old = boxes_[id];
+        const Positions& at = at_[id];
+        for (int axis = 0; axis < D; ++axis) {
+            if (old.lo[axis] == box.lo[axis] && old.hi[axis] == box.hi[axis]) {
+                continue;
+            }
+            axes_[axis][at[2 * axis]].setValue(box.lo[axis]);
+            axes_[axis][at[2 * axis + 1]].setValue(box.hi[axis]);
+            valuesChanged_[axis] = true;
+        }
+        old = box;
     }
 
     /// One insertion sort over `which` (sweep_detail::insertionPass), the axis made a
@@ -621,6 +658,12 @@ class SweepAndPrune {
     std::size_t dead_ = 0;
     std::size_t swaps_ = 0;
     std::size_t passesLeftOut_ = 0;
+    /// Whether update() writes a sorted object's new values at once (after a search in
+    /// which many moved), the moves it wrote since the last maintain(), and in all.
+    bool writeAtUpdate_ = false;
+    std::size_t writtenMoves_ = 0;
+    std::size_t movesWrittenAtUpdate_ = 0;
+    std::array<bool, D> valuesChanged_{};  ///< per axis: a batch wrote new values there
     /// Per axis: sorted outright (else only each min against each max, see kindOrderHolds).
     std::array<bool, D> sorted_ = filled(true);
     std::array<std::uint8_t, D> checkAfter_{};  ///< per axis: passes until its next check

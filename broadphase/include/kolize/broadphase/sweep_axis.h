@@ -62,11 +62,25 @@ struct Endpoint<float> {
         return out;
     }
     void setValue(float value) {
-        key = (std::uint64_t(ordered(value)) << 32) | (key & 0xffffffffu);
+        const std::uint32_t high = ordered(value);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        // A store of the high half alone: a batch's moves write six endpoints each, spread
+        // over three arrays, and a read-modify-write waits for each line (the stack's
+        // awake frames: the core 25 -> 18 us with the writes at update()).
+        std::memcpy(reinterpret_cast<unsigned char*>(&key) + 4, &high, sizeof high);
+#else
+        key = (std::uint64_t(high) << 32) | (key & 0xffffffffu);
+#endif
     }
-    ObjectId id() const { return ObjectId(key & 0x7fffffffu); }
-    bool isMax() const { return (key & 0x80000000u) != 0; }
-    friend bool before(const Endpoint& a, const Endpoint& b) { return a.key < b.key; }
+    ObjectId id() const {
+        return ObjectId(key & 0x7fffffffu);
+    }
+    bool isMax() const {
+        return (key & 0x80000000u) != 0;
+    }
+    friend bool before(const Endpoint& a, const Endpoint& b) {
+        return a.key < b.key;
+    }
 };
 
 /// Per object: the positions of its min and max on every axis (2 * axis + 0 / 1), kept
