@@ -316,6 +316,9 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         if (box == boxes_[slot]) {
             return;  // unchanged (resting and sleeping bodies): nothing to do
         }
+        if (searching_) {
+            movedInSearch_.push_back(slot);
+        }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
         if ((slot & spreadMask_) == spreadClass_) {
@@ -663,6 +666,8 @@ std::vector<BroadphaseAdapter::QueryHit>& BroadphaseAdapter::beginQuery(bool ray
 bool BroadphaseAdapter::beginPairs() {
     searching_ = true;
     trackedBoxesChanged_ = false;
+    recheck_.swap(movedInSearch_);
+    movedInSearch_.clear();
     if (++stamp_ == 0) {  // wrapped: no pair may look tested in this frame
         for (std::uint32_t at = 0; at < pairs_.size(); ++at) {
             pairs_[at].stamp = 0;
@@ -699,13 +704,17 @@ bool BroadphaseAdapter::beginPairs() {
     }
     ++measuredFrames_;
     // The core's all-pairs search pays when many objects moved (and on the first frame).
+    bool full = counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
     if (forceFullSearch_) {
         forceFullSearch_ = false;
-        return true;
+        full = true;
     }
-    const bool full = counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
     if (!full) {
         indexPairs();  // certificates and queries need it (a no-op unless after a bulk frame)
+    }
+    if (!coreTracksOverlaps_) {
+        // Certificates see such a move: the odometer counts the way away and back.
+        recheck_.clear();
     }
     return full;
 }

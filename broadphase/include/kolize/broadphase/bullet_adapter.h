@@ -236,6 +236,32 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     /// pairs). After beginPairs, noteCoreChange for every pair whose boxes the core says may
     /// have started or stopped overlapping, then finishTrackedPairs tests only those.
     void noteCoreChange(ObjectId a, ObjectId b) { coreChanges_.emplace_back(a, b); }
+    /// For a core that tracks overlaps, after its changes: every pair of a slot moved during
+    /// the last search (movedInSearch_), the stored ones and those `query(box, visit)` finds
+    /// for its box now, as changed. The core saw such a move after that search had tested
+    /// the slot's pairs against it, and a move away and back in one callback is no move
+    /// to it at all.
+    template <class Query>
+    void recheckMovedInSearch(Query&& query) {
+        if (recheck_.empty()) {
+            return;
+        }
+        indexPairs();
+        for (ObjectId slot : recheck_) {
+            if (state_[slot] != SlotState::Live) {
+                continue;
+            }
+            pairs_.forEachOf(slot, [&](std::uint32_t at) {
+                coreChanges_.emplace_back(pairs_[at].object[0], pairs_[at].object[1]);
+            });
+            query(boxes_[slot], [&](ObjectId other) {
+                if (other != slot && state_[other] == SlotState::Live) {
+                    coreChanges_.emplace_back(slot, other);
+                }
+            });
+        }
+        recheck_.clear();
+    }
     void finishTrackedPairs(btDispatcher* dispatcher);
     /// Set by CoreBroadphase for a core that tracks overlaps.
     bool coreTracksOverlaps_ = false;
@@ -371,6 +397,11 @@ class BroadphaseAdapter : public btBroadphaseInterface {
     std::vector<std::uint32_t> bulkChanges_;
     std::vector<std::pair<ObjectId, ObjectId>> coreChanges_;  ///< from a core that tracks
     bool searching_ = false;
+    /// Slots whose setAabb came while a search ran (from a callback of the pair cache): the
+    /// search may have tested their pairs against either box. For a core that tracks
+    /// overlaps, the next search tests every pair of theirs again (recheck_: taken from
+    /// movedInSearch_ when it begins, see recheckMovedInSearch).
+    std::vector<ObjectId> movedInSearch_, recheck_;
     /// > 0 while pair indices must hold (a walk that calls back into Bullet): destroyed
     /// proxies' pairs are erased afterwards.
     int deferErasures_ = 0;
@@ -530,6 +561,8 @@ class CoreBroadphase final : public BroadphaseAdapter {
                 beginPairs();
                 core_.maintain();
                 core_.drainChanges([&](ObjectId a, ObjectId b) { noteCoreChange(a, b); });
+                recheckMovedInSearch(
+                    [&](const Box& box, auto&& visit) { core_.queryBox(box, visit); });
                 finishTrackedPairs(dispatcher);
                 return;
             }
