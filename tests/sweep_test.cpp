@@ -440,8 +440,9 @@ void runUnsortedRuns(std::uint32_t seed) {
     // Meaningful: passes were left out, the other paths all ran, the queries found objects.
     EXPECT_GT(core.passesLeftOut(), 300u);
     EXPECT_GT(core.oneByOneSearches(), 10u);
-    // Jitter frames wrote the next frame's moves at update() (every live object, 8 frames in
-    // 12), and the far moves after them too (3 objects, a batch of few).
+    // A jitter frame after a jitter frame has its moves written at update() (every live
+    // object, 7 frames in 12), and so have the far moves after one (3 objects, a batch of
+    // few).
     EXPECT_GT(core.movesWrittenAtUpdate(), 100u * 140u);
     EXPECT_GT(midFrameHits, 240u * 10u);
     EXPECT_GT(bigMoves, 20u);
