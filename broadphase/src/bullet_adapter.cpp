@@ -316,8 +316,8 @@ void BroadphaseAdapter::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbM
         if (box == boxes_[slot]) {
             return;  // unchanged (resting and sleeping bodies): nothing to do
         }
-        if (searching_) {
-            movedInSearch_.push_back(slot);
+        if (searching_ && coreTracksOverlaps_) {
+            movedInSearch_.push_back(slot);  // the other cores' certificates see such a move
         }
         ours->m_aabbMin = aabbMin;
         ours->m_aabbMax = aabbMax;
@@ -704,17 +704,13 @@ bool BroadphaseAdapter::beginPairs() {
     }
     ++measuredFrames_;
     // The core's all-pairs search pays when many objects moved (and on the first frame).
-    bool full = counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
     if (forceFullSearch_) {
         forceFullSearch_ = false;
-        full = true;
+        return true;
     }
+    const bool full = counters_.frames == 0 ? liveCount_ > 0 : coreMoved * 4 > liveCount_;
     if (!full) {
         indexPairs();  // certificates and queries need it (a no-op unless after a bulk frame)
-    }
-    if (!coreTracksOverlaps_) {
-        // Certificates see such a move: the odometer counts the way away and back.
-        recheck_.clear();
     }
     return full;
 }
